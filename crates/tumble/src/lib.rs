@@ -1,0 +1,47 @@
+//! Tumble: a rigid-body dynamics engine.
+//!
+//! ```
+//! use tumble::prelude::*;
+//! let mut world = World::new(&WorldDef::default());
+//! let ball = world
+//!     .create_body(
+//!         &BodyDef { position: Vec3::new(0.0, 5.0, 0.0), mass: MassSpec::Mass(1.0), ..Default::default() },
+//!         Shape::sphere(0.1),
+//!     )
+//!     .unwrap();
+//! world.step(0.01).unwrap();
+//! assert!(world.body(ball).unwrap().position().y < 5.0);
+//! ```
+#![warn(missing_docs)]
+
+pub mod analysis;
+pub mod body;
+pub mod diagnostics;
+pub mod error;
+pub mod force;
+pub mod id;
+pub mod integrate;
+pub mod math;
+pub mod shape;
+pub mod world;
+
+pub use body::{Body, BodyDef, BodyKind, InertiaSpec, MassSpec};
+pub use diagnostics::Diagnostics;
+pub use error::{Error, Result};
+pub use force::{
+    AppliedForce, Drag, Force, ForceCallback, ForceContext, Spring, SpringEnd, Wrench,
+};
+pub use id::{BodyId, ForceId};
+pub use integrate::Integrator;
+pub use math::{Mat3, Quat, Real, Vec3};
+pub use shape::{CompoundChild, ConvexHull, MassProperties, Shape};
+pub use world::{World, WorldDef};
+
+/// Everything a typical user needs, in one import.
+pub mod prelude {
+    pub use crate::{
+        AppliedForce, Body, BodyDef, BodyId, BodyKind, CompoundChild, Diagnostics, Drag, Error,
+        Force, ForceId, InertiaSpec, Integrator, MassSpec, Mat3, Quat, Real, Shape, Spring,
+        SpringEnd, Vec3, World, WorldDef,
+    };
+}
