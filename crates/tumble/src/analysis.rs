@@ -129,6 +129,8 @@ pub struct EnergyBehaviour {
     pub max_deviation: Real,
     /// Energy sampled once per period, relative to E₀.
     pub per_period: Vec<Real>,
+    /// Largest |E − E₀| / E₀ within each period.
+    pub deviation_per_period: Vec<Real>,
 }
 
 /// Energy of the ω = 2π oscillator over `periods` periods at step `dt`.
@@ -139,14 +141,18 @@ pub fn energy_behaviour(integrator: Integrator, dt: Real, periods: usize) -> Ene
     let steps_per_period = (1.0 / dt).round() as usize;
     let mut max_deviation: Real = 0.0;
     let mut per_period = vec![1.0];
+    let mut deviation_per_period = Vec::new();
     for _ in 0..periods {
+        let mut deviation: Real = 0.0;
         for _ in 0..steps_per_period {
             if world.step(dt).is_err() {
                 break;
             }
             let e = world.diagnostics().total;
-            max_deviation = max_deviation.max(((e - e0) / e0).abs());
+            deviation = deviation.max(((e - e0) / e0).abs());
         }
+        max_deviation = max_deviation.max(deviation);
+        deviation_per_period.push(deviation);
         per_period.push(world.diagnostics().total / e0);
     }
     EnergyBehaviour {
@@ -154,6 +160,7 @@ pub fn energy_behaviour(integrator: Integrator, dt: Real, periods: usize) -> Ene
         final_change: per_period.last().copied().unwrap_or(1.0) - 1.0,
         max_deviation,
         per_period,
+        deviation_per_period,
     }
 }
 

@@ -41,7 +41,7 @@ pub use world::{World, WorldDef};
 pub mod prelude {
     pub use crate::{
         AppliedForce, Body, BodyDef, BodyId, BodyKind, CompoundChild, Diagnostics, Drag, Error,
-        Force, ForceId, InertiaSpec, Integrator, MassSpec, Mat3, Quat, Real, Shape, Spring,
-        SpringEnd, Vec3, World, WorldDef,
+        Force, ForceContext, ForceId, InertiaSpec, Integrator, MassSpec, Mat3, Quat, Real, Shape,
+        Spring, SpringEnd, Vec3, World, WorldDef,
     };
 }

@@ -114,6 +114,7 @@ pub fn vec3_is_finite(v: Vec3) -> bool {
 /// Returns the eigenvalues and a proper rotation (det = +1) whose columns are the matching
 /// unit eigenvectors, so `m = R diag(λ) Rᵀ`. Jacobi is chosen over the closed-form cubic
 /// because it stays accurate for the nearly repeated eigenvalues of symmetric bodies.
+#[allow(clippy::needless_range_loop)] // index loops mirror the rotation formulas
 pub fn symmetric_eigen(m: Mat3) -> (Vec3, Mat3) {
     let mut a = [[0.0 as Real; 3]; 3];
     for (c, col) in [m.x_axis, m.y_axis, m.z_axis].iter().enumerate() {

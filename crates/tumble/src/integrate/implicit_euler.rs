@@ -234,6 +234,7 @@ fn apply_system(
 }
 
 /// Solves for Δu into `b.x`, preconditioned by the inverse mass and inertia.
+#[allow(clippy::needless_range_loop)] // the CG updates read best as the textbook's loops
 fn conjugate_gradient(bodies: &[Body], b: &mut Buffers, h: Real) {
     let norm_b: Real = b.rhs.iter().map(|t| t.dot(*t)).sum::<Real>().sqrt();
     if norm_b == 0.0 {

@@ -41,8 +41,13 @@ pub(super) fn symplectic_euler(
     drift_all(sys.bodies, motions, h);
 }
 
-/// The seed's four steps: x₊ = x + v h + ½ a h², v½ = v + ½ a h, a₊ = F(x₊, v½)/m,
+/// The seed's four steps: x₊ = x + v h + ½ a h², v½ = v + ½ a h, a₊ = F(x₊, v₊)/m,
 /// v₊ = v½ + ½ a₊ h; the same for L with the rotor drift in between.
+///
+/// Step 3 needs v₊ before it is known. Forces that do not depend on velocity ignore it
+/// (and the method is then exactly the symplectic kick–drift–kick); for damping and drag
+/// it is predicted as v½ + ½ a h. Evaluating at v½ instead, as many codes do, silently
+/// drops the method to first order whenever there is damping.
 pub(super) fn velocity_verlet(
     sys: &mut System<'_>,
     motions: &mut [Motion],
@@ -53,7 +58,9 @@ pub(super) fn velocity_verlet(
     sys.wrenches(t, motions, &mut s.wrench);
     kick(sys.bodies, motions, &s.wrench, 0.5 * h);
     drift_all(sys.bodies, motions, h);
-    sys.wrenches(t + h, motions, &mut s.wrench);
+    s.stage.copy_from_slice(motions);
+    kick(sys.bodies, &mut s.stage, &s.wrench, 0.5 * h);
+    sys.wrenches(t + h, &s.stage, &mut s.wrench);
     kick(sys.bodies, motions, &s.wrench, 0.5 * h);
 }
 

@@ -1,0 +1,47 @@
+//! Helpers shared by the physics tests.
+#![allow(dead_code)]
+
+use tumble::prelude::*;
+
+/// The tolerance for the build's precision: `f64_tol` normally, `f32_tol` with `--features f32`.
+pub fn tol(f64_tol: f64, f32_tol: f64) -> Real {
+    if std::mem::size_of::<Real>() == 8 {
+        f64_tol as Real
+    } else {
+        f32_tol as Real
+    }
+}
+
+/// True in the f32 build.
+pub fn single_precision() -> bool {
+    std::mem::size_of::<Real>() == 4
+}
+
+/// A world with the given gravity and integrator.
+pub fn world(gravity: Vec3, integrator: Integrator) -> World {
+    World::new(&WorldDef {
+        gravity,
+        integrator,
+    })
+}
+
+/// A 1 kg ball of radius 0.1 m at `position`.
+pub fn ball(world: &mut World, position: Vec3) -> BodyId {
+    world
+        .create_body(
+            &BodyDef {
+                position,
+                mass: MassSpec::Mass(1.0),
+                ..Default::default()
+            },
+            Shape::sphere(0.1),
+        )
+        .unwrap()
+}
+
+/// Steps `n` times.
+pub fn run(world: &mut World, dt: Real, n: usize) {
+    for _ in 0..n {
+        world.step(dt).unwrap();
+    }
+}
