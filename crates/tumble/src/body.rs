@@ -118,6 +118,8 @@ pub struct Body {
     /// Principal moments and the body-frame unit axes they belong to (columns, det +1).
     pub(crate) principal_moments: Vec3,
     pub(crate) principal_axes: Mat3,
+    /// The same axes as a rotation from the principal frame to the body frame.
+    pub(crate) principal_rotation: Quat,
     /// For planar bodies, I_zz of the world tensor, constant under rotations about z.
     pub(crate) planar_inertia: Real,
     // State.
@@ -149,6 +151,7 @@ impl Body {
             inv_inertia_local: axes * Mat3::from_diagonal(moments.recip()) * axes.transpose(),
             principal_moments: moments,
             principal_axes: axes,
+            principal_rotation: Quat::from_mat3(&axes).normalize(),
             planar_inertia: 0.0,
             com: def.position + orientation * props.center,
             orientation,
@@ -314,7 +317,39 @@ fn mass_properties(def: &BodyDef, shape: &Shape) -> Result<MassProperties> {
     if let Some(spec) = def.inertia {
         props.inertia = validate_inertia(spec)?;
     }
+    check_mass_came_out(def, shape, &props)?;
     Ok(props)
+}
+
+/// Valid sizes can still multiply out to nothing or to infinity (a 1e-120 m sphere has no
+/// volume in floating point, 1e308 kg/m³ times a litre overflows); such a body would
+/// turn NaN on its first step. The error names the factor that is out of range.
+fn check_mass_came_out(def: &BodyDef, shape: &Shape, props: &MassProperties) -> Result<()> {
+    let good = |x: Real| x.is_finite() && x > 0.0;
+    let (moments, _) = crate::math::symmetric_eigen(props.inertia);
+    if good(props.mass) && good(moments.x) && good(moments.y) && good(moments.z) {
+        return Ok(());
+    }
+    let unit = shape.mass_properties(1.0);
+    let (unit_moments, _) = crate::math::symmetric_eigen(unit.inertia);
+    let field = if !good(unit.mass)
+        || !good(unit_moments.min_element())
+        || !good(unit_moments.max_element())
+    {
+        "shape"
+    } else {
+        match def.mass {
+            MassSpec::Density(_) => "density",
+            MassSpec::Mass(_) => "mass",
+        }
+    };
+    Err(Error::invalid(
+        field,
+        format!(
+            "mass and inertia come out zero or infinite at this size ({} kg, principal moments [{}, {}, {}] kg·m²)",
+            props.mass, moments.x, moments.y, moments.z
+        ),
+    ))
 }
 
 /// A tensor must be symmetric, positive definite and physically possible: no principal

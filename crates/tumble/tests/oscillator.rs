@@ -6,7 +6,7 @@
 mod common;
 use common::*;
 use tumble::analysis::{
-    convergence, energy_behaviour, largest_stable_step, oscillator, oscillator_exact,
+    convergence, default_steps, energy_behaviour, largest_stable_step, oscillator, oscillator_exact,
 };
 use tumble::prelude::*;
 
@@ -15,12 +15,7 @@ fn observed_orders_match_the_theory() {
     // Expected orders in the order Integrator::ALL lists them.
     let expected = [1.0, 1.0, 1.0, 2.0, 4.0, 2.0, 2.0];
     for (integrator, want) in Integrator::ALL.into_iter().zip(expected) {
-        // In f32 the finest steps of RK4 would sink below rounding; it starts coarser.
-        let (dt0, levels) = match (single_precision(), integrator.order()) {
-            (false, _) => (0.0125, 5),
-            (true, 4) => (0.075, 3),
-            (true, _) => (0.0125, 3),
-        };
+        let (dt0, levels) = default_steps(integrator);
         let c = convergence(integrator, dt0, levels);
         assert!(
             (c.order - want).abs() <= 0.2,

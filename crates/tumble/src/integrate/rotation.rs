@@ -34,20 +34,59 @@ pub(crate) fn exact_spin(w: Vec3, q: Quat, h: Real) -> Quat {
 }
 
 /// The symmetric principal-axis splitting of the torque-free rotor.
-fn free_rotor(body: &Body, mut q: Quat, l: Vec3, h: Real) -> Quat {
-    let axes = [
-        body.principal_axes.x_axis,
-        body.principal_axes.y_axis,
-        body.principal_axes.z_axis,
-    ];
-    let moments = body.principal_moments;
-    let moment = |i: usize| [moments.x, moments.y, moments.z][i];
-    for (i, fraction) in [(0usize, 0.5), (1, 0.5), (2, 1.0), (1, 0.5), (0, 0.5)] {
-        // Π along axis i is constant during its own sub-flow: the body turns about that
-        // axis, which leaves the component of Π along it unchanged.
-        let pi = (q.inverse() * l).dot(axes[i]);
-        let angle = fraction * h * pi / moment(i);
-        q *= Quat::from_axis_angle(axes[i], angle);
+///
+/// Works in the principal frame, where each sub-flow is a rotation about a coordinate
+/// axis: Π (body-frame L) turns backwards by the angle while the body turns forwards, so
+/// one sin/cos pair per sub-flow serves both and no quaternion rotates a vector in the loop.
+fn free_rotor(body: &Body, q: Quat, l: Vec3, h: Real) -> Quat {
+    let to_principal = body.principal_rotation;
+    let mut pi = (q * to_principal).inverse() * l;
+    let inv = body.principal_moments.recip();
+    // Accumulated rotation in the principal frame, as [x, y, z, w].
+    let mut acc = [0.0 as Real, 0.0, 0.0, 1.0];
+    for (axis, fraction) in [(0usize, 0.5), (1, 0.5), (2, 1.0), (1, 0.5), (0, 0.5)] {
+        let rate = [pi.x * inv.x, pi.y * inv.y, pi.z * inv.z][axis];
+        let (s, c) = (0.5 * fraction * h * rate).sin_cos();
+        // Turning the body by +θ about e_axis turns Π by −θ: cos θ = c² − s², sin θ = 2sc.
+        let (cos, sin) = (c * c - s * s, 2.0 * s * c);
+        pi = match axis {
+            0 => Vec3::new(pi.x, cos * pi.y + sin * pi.z, -sin * pi.y + cos * pi.z),
+            1 => Vec3::new(cos * pi.x - sin * pi.z, pi.y, sin * pi.x + cos * pi.z),
+            _ => Vec3::new(cos * pi.x + sin * pi.y, -sin * pi.x + cos * pi.y, pi.z),
+        };
+        acc = multiply_by_axis_rotation(acc, axis, s, c);
     }
-    q.normalize()
+    let acc = Quat::from_xyzw(acc[0], acc[1], acc[2], acc[3]);
+    (q * (to_principal * acc * to_principal.inverse())).normalize()
+}
+
+/// `a * (c + s e_axis)`: a quaternion times the half-angle rotation about a coordinate axis.
+#[inline]
+fn multiply_by_axis_rotation(a: [Real; 4], axis: usize, s: Real, c: Real) -> [Real; 4] {
+    let [x, y, z, w] = a;
+    match axis {
+        0 => [x * c + w * s, y * c + z * s, z * c - y * s, w * c - x * s],
+        1 => [x * c - z * s, y * c + w * s, z * c + x * s, w * c - y * s],
+        _ => [x * c + y * s, y * c - x * s, z * c + w * s, w * c - z * s],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn axis_rotation_product_matches_glam() {
+        let a = Quat::from_xyzw(0.1, -0.7, 0.3, 0.6).normalize();
+        for (axis, e) in [Vec3::X, Vec3::Y, Vec3::Z].into_iter().enumerate() {
+            let (s, c) = (0.35 as Real).sin_cos();
+            let r = multiply_by_axis_rotation([a.x, a.y, a.z, a.w], axis, s, c);
+            let expect = a * Quat::from_axis_angle(e, 0.7);
+            let got = Quat::from_xyzw(r[0], r[1], r[2], r[3]);
+            assert!(
+                (got - expect).length() < 1e-6,
+                "axis {axis}: {got} vs {expect}"
+            );
+        }
+    }
 }

@@ -10,13 +10,20 @@ use crate::body::{Body, BodyKind};
 use crate::force::Wrench;
 use crate::math::{Real, Vec3};
 
+/// Momenta change under the wrenches. ω is left stale: a drift reads only L, and
+/// whatever reads ω next calls [`refresh_all`] first.
 fn kick(bodies: &[Body], motions: &mut [Motion], wrenches: &[Wrench], h: Real) {
     for ((m, w), body) in motions.iter_mut().zip(wrenches).zip(bodies) {
         if body.kind == BodyKind::Dynamic {
             m.v += w.force * (body.inv_mass * h);
             m.l += w.torque * h;
-            refresh_omega(body, m);
         }
+    }
+}
+
+fn refresh_all(bodies: &[Body], motions: &mut [Motion]) {
+    for (m, body) in motions.iter_mut().zip(bodies) {
+        refresh_omega(body, m);
     }
 }
 
@@ -60,8 +67,10 @@ pub(super) fn velocity_verlet(
     drift_all(sys.bodies, motions, h);
     s.stage.copy_from_slice(motions);
     kick(sys.bodies, &mut s.stage, &s.wrench, 0.5 * h);
+    refresh_all(sys.bodies, &mut s.stage);
     sys.wrenches(t + h, &s.stage, &mut s.wrench);
     kick(sys.bodies, motions, &s.wrench, 0.5 * h);
+    refresh_all(sys.bodies, motions);
 }
 
 /// What Störmer–Verlet remembers of the previous step.
