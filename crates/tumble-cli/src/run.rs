@@ -1,0 +1,198 @@
+//! `tumble run`: load a scene, apply the command-line overrides, step it, record it.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use tumble::{Real, World};
+use tumble_scene::{RunPlan, Scene, SceneError};
+
+use crate::record::{CsvFile, DIAGNOSTICS_HEADER, TRAJECTORY_HEADER};
+use crate::report::{SeedTable, Summary};
+use crate::Failure;
+
+/// The scene run when none is named: the seed's example.
+pub const SEED_SCENE: &str = "free_fall";
+
+/// Options of `tumble run`; `Default` is `tumble run` with no options.
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// Scene to run: a built-in name (free_fall, spring, double_spring, dzhanibekov,
+    /// planar_spinner, dumbbell; see `tumble scenes`) or the path of a JSON scene file
+    /// (format: docs/scene-format.md). Built-in names win over files in the current
+    /// directory. Omitted: the seed's free fall, printed as a table against the analytic
+    /// solution.
+    #[arg(value_name = "SCENE")]
+    pub scene: Option<String>,
+
+    /// Simulated time to run, in seconds (s); overrides the scene's `duration`.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    pub duration: Option<Real>,
+
+    /// Number of steps of dt to take, instead of --duration.
+    #[arg(long, value_name = "N", conflicts_with = "duration")]
+    pub steps: Option<u64>,
+
+    /// Time step, in seconds (s); overrides the scene's `dt`. Must be > 0.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    pub dt: Option<Real>,
+
+    /// Integration method; overrides the scene's `integrator`. One of: explicit_euler,
+    /// symplectic_euler, implicit_euler, midpoint, rk4, verlet, velocity_verlet.
+    #[arg(long, value_name = "NAME")]
+    pub integrator: Option<String>,
+
+    /// Write the trajectory as CSV to FILE: a row per body per recorded step, columns
+    /// time (s), body (name, or index if unnamed), x,y,z (body frame origin, m),
+    /// qx,qy,qz,qw (orientation), vx,vy,vz (centre-of-mass velocity, m/s) and wx,wy,wz
+    /// (angular velocity, rad/s), all in the world frame.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+
+    /// Write energies and momenta as CSV to FILE, a row per recorded step: time (s),
+    /// kinetic, potential, total (J), px,py,pz (linear momentum, kg·m/s), lx,ly,lz
+    /// (angular momentum about the world origin, kg·m²/s).
+    #[arg(long, value_name = "FILE")]
+    pub diagnostics: Option<PathBuf>,
+
+    /// Record every K-th step in the CSV files; step 0 and the last step are always
+    /// recorded.
+    #[arg(long, value_name = "K", default_value_t = 1)]
+    pub every: u64,
+
+    /// Print nothing on standard output (errors still go to standard error).
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+impl Default for RunArgs {
+    fn default() -> Self {
+        RunArgs {
+            scene: None,
+            duration: None,
+            steps: None,
+            dt: None,
+            integrator: None,
+            out: None,
+            diagnostics: None,
+            every: 1,
+            quiet: false,
+        }
+    }
+}
+
+/// Runs the command.
+pub fn run(args: &RunArgs) -> Result<(), Failure> {
+    if args.every == 0 {
+        return Err(SceneError::new("every", "must be >= 1").into());
+    }
+    let integrator = args
+        .integrator
+        .as_deref()
+        .map(tumble_scene::parse_integrator)
+        .transpose()?;
+    let mut scene = tumble_scene::load(args.scene.as_deref().unwrap_or(SEED_SCENE))?;
+    if let Some(integrator) = integrator {
+        scene.world.set_integrator(integrator);
+    }
+    let plan = plan(args, &scene)?;
+    let mut sinks = Sinks::open(args, &scene, &plan)?;
+    step_all(&mut scene.world, &plan, args.every, &mut sinks)?;
+    sinks.finish(&scene, &plan)
+}
+
+/// The command line's duration, steps and dt over the scene's.
+fn plan(args: &RunArgs, scene: &Scene) -> Result<RunPlan, SceneError> {
+    let dt = args.dt.unwrap_or(scene.dt);
+    match args.steps {
+        Some(steps) => RunPlan::from_steps(steps, dt),
+        None => RunPlan::from_duration(args.duration.unwrap_or(scene.duration), dt),
+    }
+}
+
+/// Steps the world through `plan`, showing step 0, every `every`-th step and the last to
+/// the sinks. A failed step ends the run with its error; nothing is unwrapped.
+fn step_all(
+    world: &mut World,
+    plan: &RunPlan,
+    every: u64,
+    sinks: &mut Sinks,
+) -> Result<(), Failure> {
+    sinks.observe(0, 0.0, world, true)?;
+    for k in 1..=plan.steps {
+        world
+            .step(plan.step_dt(k))
+            .map_err(|e| Failure::Runtime(format!("step {k}: {e}")))?;
+        let record = k % every == 0 || k == plan.steps;
+        sinks.observe(k, plan.time_after(k), world, record)?;
+    }
+    Ok(())
+}
+
+/// Everything that watches the run: the CSV files and the printed reports.
+struct Sinks {
+    trajectory: Option<CsvFile>,
+    diagnostics: Option<CsvFile>,
+    seed_table: Option<SeedTable>,
+    summary: Option<Summary>,
+    labels: Vec<String>,
+    quiet: bool,
+}
+
+impl Sinks {
+    fn open(args: &RunArgs, scene: &Scene, plan: &RunPlan) -> Result<Sinks, Failure> {
+        if args.out.is_some() && args.out == args.diagnostics {
+            return Err(SceneError::new("diagnostics", "must be a different file from out").into());
+        }
+        let csv = |field, path: &Option<PathBuf>, header| {
+            path.as_deref()
+                .map(|p| CsvFile::create(field, p, header))
+                .transpose()
+        };
+        let seed = args.scene.is_none() && !args.quiet;
+        Ok(Sinks {
+            trajectory: csv("out", &args.out, TRAJECTORY_HEADER)?,
+            diagnostics: csv("diagnostics", &args.diagnostics, DIAGNOSTICS_HEADER)?,
+            seed_table: seed
+                .then(|| SeedTable::new(&scene.world, plan))
+                .transpose()?,
+            summary: (!seed && !args.quiet).then(|| Summary::new(scene)),
+            labels: scene.body_names.clone(),
+            quiet: args.quiet,
+        })
+    }
+
+    /// After step `k` (0: the initial state) at `time`; `record` says whether the CSV
+    /// files take this step.
+    fn observe(&mut self, k: u64, time: Real, world: &World, record: bool) -> Result<(), Failure> {
+        if record {
+            if let Some(csv) = &mut self.trajectory {
+                csv.trajectory(time, world, &self.labels)?;
+            }
+            if let Some(csv) = &mut self.diagnostics {
+                csv.diagnostics(time, world)?;
+            }
+        }
+        if let Some(table) = &mut self.seed_table {
+            table.observe(k, time, world)?;
+        }
+        Ok(())
+    }
+
+    fn finish(self, scene: &Scene, plan: &RunPlan) -> Result<(), Failure> {
+        let mut written = Vec::new();
+        for csv in [self.trajectory, self.diagnostics].into_iter().flatten() {
+            let path = csv.path().display().to_string();
+            written.push((path, csv.finish()?));
+        }
+        if let Some(table) = self.seed_table {
+            table.finish(&scene.world, plan)?;
+        }
+        if let Some(summary) = self.summary {
+            summary.print(scene, plan)?;
+        }
+        if self.quiet {
+            return Ok(());
+        }
+        crate::report::print_written(&written)
+    }
+}

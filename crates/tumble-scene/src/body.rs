@@ -1,0 +1,113 @@
+//! Bodies: one entry of the `bodies` array, read into a `BodyDef` and a `Shape`.
+
+use tumble::{BodyDef, BodyKind, InertiaSpec, MassSpec, Mat3, Quat, Shape, Vec3};
+
+use crate::error::{printable, Result};
+use crate::reader::{Node, Obj};
+
+const BODY_KEYS: [&str; 12] = [
+    "name",
+    "kind",
+    "shape",
+    "mass",
+    "density",
+    "inertia",
+    "center_of_mass",
+    "position",
+    "orientation",
+    "velocity",
+    "angular_velocity",
+    "planar",
+];
+
+/// The body kinds, as scene files name them.
+pub const BODY_KINDS: [&str; 3] = ["static", "kinematic", "dynamic"];
+
+/// Reads one body. Values are only checked for form here; the engine checks the rules
+/// (positive mass, non-zero quaternion, plausible inertia) in `World::create_body`.
+pub(crate) fn body(node: &Node<'_>) -> Result<(BodyDef, Shape)> {
+    let obj = node.object()?;
+    obj.only(&BODY_KEYS)?;
+    let def = BodyDef {
+        name: name(&obj)?,
+        kind: kind(&obj)?,
+        position: obj.vec3("position")?.unwrap_or(Vec3::ZERO),
+        orientation: obj.quat("orientation")?.unwrap_or(Quat::IDENTITY),
+        linear_velocity: obj.vec3("velocity")?.unwrap_or(Vec3::ZERO),
+        angular_velocity: obj.vec3("angular_velocity")?.unwrap_or(Vec3::ZERO),
+        mass: mass(&obj)?,
+        inertia: obj.get("inertia").map(|n| inertia(&n)).transpose()?,
+        center_of_mass: obj.vec3("center_of_mass")?,
+        planar: obj.bool("planar")?.unwrap_or(false),
+    };
+    let shape = crate::shape::shape(&obj.required("shape")?)?;
+    Ok((def, shape))
+}
+
+/// Names label CSV rows, where unnamed bodies are labelled by their index; a name made
+/// of digits could be mistaken for another body's index, so it is refused.
+fn name(obj: &Obj<'_>) -> Result<Option<String>> {
+    let Some(name) = obj.str("name")? else {
+        return Ok(None);
+    };
+    if name.is_empty() {
+        return Err(obj.err_at("name", "must not be empty"));
+    }
+    if name.chars().any(char::is_control) {
+        return Err(obj.err_at("name", "must not contain control characters"));
+    }
+    if name.bytes().all(|b| b.is_ascii_digit()) {
+        return Err(obj.err_at(
+            "name",
+            "must not be a plain number (unnamed bodies are labelled by their index)",
+        ));
+    }
+    Ok(Some(name.to_string()))
+}
+
+fn kind(obj: &Obj<'_>) -> Result<BodyKind> {
+    let Some(kind) = obj.str("kind")? else {
+        return Ok(BodyKind::Dynamic);
+    };
+    BodyKind::from_name(kind).ok_or_else(|| {
+        obj.err_at(
+            "kind",
+            format!(
+                "unknown kind '{}' (expected one of: {})",
+                printable(kind),
+                BODY_KINDS.join(", ")
+            ),
+        )
+    })
+}
+
+fn mass(obj: &Obj<'_>) -> Result<MassSpec> {
+    match (obj.real("mass")?, obj.real("density")?) {
+        (Some(_), Some(_)) => Err(obj.err_at(
+            "density",
+            "cannot be given together with mass (give one of mass, density)",
+        )),
+        (Some(m), None) => Ok(MassSpec::Mass(m)),
+        (None, Some(d)) => Ok(MassSpec::Density(d)),
+        (None, None) => Ok(MassSpec::default()),
+    }
+}
+
+/// Three principal moments `[Ixx, Iyy, Izz]` or a full tensor as three rows.
+fn inertia(node: &Node<'_>) -> Result<InertiaSpec> {
+    if !node.is_array_of_arrays() {
+        let [x, y, z] = node.reals::<3>("[Ixx, Iyy, Izz] (or a 3x3 matrix of rows)")?;
+        return Ok(InertiaSpec::Principal(Vec3::new(x, y, z)));
+    }
+    let rows = node.array()?;
+    let [a, b, c] = rows.as_slice() else {
+        return Err(node.err("expected a 3x3 matrix [[..], [..], [..]] (or 3 principal moments)"));
+    };
+    let rows = [a, b, c].map(|r| r.reals::<3>("(a matrix row)"));
+    let [a, b, c] = rows;
+    // Rows in, columns in glam: the transpose (a no-op for the symmetric tensors the
+    // engine accepts, but an asymmetric one should be reported as given).
+    Ok(InertiaSpec::Tensor(
+        Mat3::from_cols_array_2d(&[a?, b?, c?]).transpose(),
+    ))
+}

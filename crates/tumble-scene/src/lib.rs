@@ -1,0 +1,221 @@
+//! Tumble's JSON scene format: a document describing bodies, force elements and run
+//! settings, read into a [`tumble::World`].
+//!
+//! Every refusal is one [`SceneError`] whose `Display` is a single line naming the field,
+//! `bodies[3].shape.radius: must be > 0`. The format is documented key by key in
+//! `docs/scene-format.md`; the built-in scenes are in [`mod@builtin`].
+//!
+//! ```
+//! let scene = tumble_scene::load("free_fall").unwrap();
+//! assert_eq!(scene.body_names, ["ball"]);
+//! assert_eq!(scene.plan().unwrap().steps, 100);
+//! ```
+#![warn(missing_docs)]
+
+mod body;
+pub mod builtin;
+mod error;
+mod force;
+mod plan;
+mod reader;
+mod shape;
+
+use std::fmt;
+use std::path::Path;
+
+use serde_json::Value;
+use tumble::{Integrator, Real, Vec3, World, WorldDef};
+
+pub use body::BODY_KINDS;
+pub use builtin::{builtin, builtin_names};
+pub use error::{printable, Result, SceneError};
+pub use force::FORCE_TYPES;
+pub use plan::{RunPlan, MAX_STEPS};
+pub use reader::ROOT;
+pub use shape::SHAPE_TYPES;
+
+use reader::{Node, Obj};
+
+const TOP_KEYS: [&str; 8] = [
+    "name",
+    "description",
+    "gravity",
+    "dt",
+    "duration",
+    "integrator",
+    "bodies",
+    "forces",
+];
+
+/// Default step (s).
+pub const DEFAULT_DT: Real = 0.01;
+/// Default run length (s).
+pub const DEFAULT_DURATION: Real = 1.0;
+
+/// A loaded scene: the world at time 0 and how long to run it.
+pub struct Scene {
+    /// The document's `name`, if it has one.
+    pub name: Option<String>,
+    /// The document's `description`, if it has one.
+    pub description: Option<String>,
+    /// The world, with every body and force element created, at time 0.
+    pub world: World,
+    /// Step (s).
+    pub dt: Real,
+    /// Run length (s).
+    pub duration: Real,
+    /// A label per body in creation order (the order of `world.body_ids()`): its name, or
+    /// its index in `bodies` when it has none. Used to label output rows.
+    pub body_names: Vec<String>,
+}
+
+impl Scene {
+    /// The steps of a run of `duration` with `dt` (see [`RunPlan`]).
+    pub fn plan(&self) -> Result<RunPlan> {
+        RunPlan::from_duration(self.duration, self.dt)
+    }
+}
+
+impl fmt::Debug for Scene {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        // World holds boxed callbacks and is not Debug; its size and settings suffice.
+        f.debug_struct("Scene")
+            .field("name", &self.name)
+            .field("dt", &self.dt)
+            .field("duration", &self.duration)
+            .field("integrator", &self.world.integrator())
+            .field("gravity", &self.world.gravity())
+            .field("body_names", &self.body_names)
+            .field("forces", &self.world.forces().count())
+            .finish()
+    }
+}
+
+/// Reads a scene from JSON text.
+pub fn load_str(json: &str) -> Result<Scene> {
+    let value: Value = serde_json::from_str(json).map_err(json_error)?;
+    build(&Node::root(&value))
+}
+
+/// Reads a scene file.
+pub fn load_file(path: impl AsRef<Path>) -> Result<Scene> {
+    let path = path.as_ref();
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        SceneError::new(
+            ROOT,
+            format!(
+                "cannot read '{}': {e}",
+                printable(&path.display().to_string())
+            ),
+        )
+    })?;
+    load_str(&text)
+}
+
+/// Reads a built-in scene by name, or else a file by path. Built-in names win, so a file
+/// in the current directory called `spring` is reached as `./spring`.
+pub fn load(name_or_path: &str) -> Result<Scene> {
+    match builtin(name_or_path) {
+        Some(json) => load_str(json),
+        None if Path::new(name_or_path).exists() => load_file(name_or_path),
+        None => Err(SceneError::new(
+            ROOT,
+            format!(
+                "'{}' is neither a built-in scene ({}) nor an existing file",
+                printable(name_or_path),
+                builtin_names().join(", ")
+            ),
+        )),
+    }
+}
+
+/// serde_json appends " at line L column C" to its messages; the position goes first here.
+fn json_error(e: serde_json::Error) -> SceneError {
+    let full = e.to_string();
+    let suffix = format!(" at line {} column {}", e.line(), e.column());
+    let what = full.strip_suffix(&suffix).unwrap_or(&full);
+    SceneError::new(
+        ROOT,
+        format!(
+            "invalid JSON at line {} column {}: {what}",
+            e.line(),
+            e.column()
+        ),
+    )
+}
+
+fn build(root: &Node<'_>) -> Result<Scene> {
+    let obj = root.object()?;
+    obj.only(&TOP_KEYS)?;
+    let name = obj.str("name")?.map(str::to_string);
+    let description = obj.str("description")?.map(str::to_string);
+    let def = WorldDef {
+        gravity: obj.vec3("gravity")?.unwrap_or(Vec3::new(0.0, -9.8, 0.0)),
+        integrator: integrator(&obj)?,
+    };
+    let dt = obj.real("dt")?.unwrap_or(DEFAULT_DT);
+    let duration = obj.real("duration")?.unwrap_or(DEFAULT_DURATION);
+    // Checked now, so a bad value is reported as the scene's, not when a run starts.
+    plan::check_settings(duration, dt)?;
+    let mut world = World::new(&def);
+    let body_names = add_bodies(&obj, &mut world)?;
+    add_forces(&obj, &mut world)?;
+    Ok(Scene {
+        name,
+        description,
+        world,
+        dt,
+        duration,
+        body_names,
+    })
+}
+
+/// The integrator called `name`, with the scene format's error for any other name.
+pub fn parse_integrator(name: &str) -> Result<Integrator> {
+    Integrator::from_name(name).ok_or_else(|| {
+        SceneError::new(
+            "integrator",
+            format!(
+                "unknown integrator '{}' (expected one of: {})",
+                printable(name),
+                Integrator::names()
+            ),
+        )
+    })
+}
+
+fn integrator(obj: &Obj<'_>) -> Result<Integrator> {
+    match obj.str("integrator")? {
+        None => Ok(Integrator::default()),
+        // The key is top-level, so its path is the bare `integrator` this error names.
+        Some(name) => parse_integrator(name),
+    }
+}
+
+fn add_bodies(obj: &Obj<'_>, world: &mut World) -> Result<Vec<String>> {
+    let Some(bodies) = obj.get("bodies") else {
+        return Ok(Vec::new());
+    };
+    let mut names = Vec::new();
+    for (i, node) in bodies.array()?.iter().enumerate() {
+        let (def, shape) = body::body(node)?;
+        names.push(def.name.clone().unwrap_or_else(|| i.to_string()));
+        world
+            .create_body(&def, shape)
+            .map_err(|e| SceneError::from_engine(e, node.path()))?;
+    }
+    Ok(names)
+}
+
+fn add_forces(obj: &Obj<'_>, world: &mut World) -> Result<()> {
+    let Some(forces) = obj.get("forces") else {
+        return Ok(());
+    };
+    for node in forces.array()? {
+        let force = force::force(&node, world)?;
+        world
+            .add_force(force)
+            .map_err(|e| SceneError::from_engine(e, node.path()))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,356 @@
+//! Every refusal is one line naming its field; these pin the exact wording.
+
+use tumble_scene::load_str;
+
+/// The error line for `json`, which must be refused.
+fn error(json: &str) -> String {
+    match load_str(json) {
+        Ok(scene) => panic!("accepted {json}: {scene:?}"),
+        Err(e) => {
+            let line = e.to_string();
+            assert!(!line.contains('\n'), "multi-line error: {line}");
+            assert_eq!(line, format!("{}: {}", e.field, e.reason));
+            line
+        }
+    }
+}
+
+/// A scene with one body whose fields are `body` (JSON object members).
+fn one_body(body: &str) -> String {
+    format!(r#"{{"bodies": [{{"shape": {{"type": "sphere", "radius": 0.1}}, {body}}}]}}"#)
+}
+
+/// A body named ball, and the `forces` array given.
+fn with_forces(forces: &str) -> String {
+    format!(
+        r#"{{"bodies": [{{"name": "ball", "shape": {{"type": "sphere", "radius": 0.1}}}},
+                        {{"name": "cup", "shape": {{"type": "box", "half_extents": [1, 1, 1]}}}}],
+             "forces": {forces}}}"#
+    )
+}
+
+#[test]
+fn misspelt_keys_are_refused_with_the_allowed_ones() {
+    assert_eq!(
+        error(r#"{"bodies": [{"shape": {"type": "sphere", "radiuss": 0.1}}]}"#),
+        "bodies[0].shape.radiuss: unknown key (expected one of: type, radius)"
+    );
+    assert_eq!(
+        error(r#"{"gravityy": [0, 0, 0]}"#),
+        "gravityy: unknown key (expected one of: name, description, gravity, dt, duration, \
+         integrator, bodies, forces)"
+    );
+    assert_eq!(
+        error(&one_body(r#""velocty": [1, 0, 0]"#)),
+        "bodies[0].velocty: unknown key (expected one of: name, kind, shape, mass, density, \
+         inertia, center_of_mass, position, orientation, velocity, angular_velocity, planar)"
+    );
+    assert_eq!(
+        error(&with_forces(
+            r#"[{"type": "drag", "body": "ball", "lineer": 1}]"#
+        )),
+        "forces[0].lineer: unknown key (expected one of: type, body, linear, quadratic)"
+    );
+    let child = r#"{"bodies": [{"shape": {"type": "compound", "children": [
+        {"shape": {"type": "sphere", "radius": 1}, "rotation": [0, 0, 0, 1]}]}}]}"#;
+    assert_eq!(
+        error(child),
+        "bodies[0].shape.children[0].rotation: unknown key (expected one of: shape, position, \
+         orientation)"
+    );
+}
+
+#[test]
+fn unknown_names_list_the_known_ones() {
+    assert_eq!(
+        error(r#"{"bodies": [{"shape": {"type": "cone", "radius": 0.1}}]}"#),
+        "bodies[0].shape.type: unknown shape type 'cone' (expected one of: sphere, box, capsule, \
+         cylinder, convex_hull, compound)"
+    );
+    assert_eq!(
+        error(r#"{"integrator": "rk5"}"#),
+        "integrator: unknown integrator 'rk5' (expected one of: explicit_euler, symplectic_euler, \
+         implicit_euler, midpoint, rk4, verlet, velocity_verlet)"
+    );
+    assert_eq!(
+        error(&one_body(r#""kind": "floating""#)),
+        "bodies[0].kind: unknown kind 'floating' (expected one of: static, kinematic, dynamic)"
+    );
+    assert_eq!(
+        error(&with_forces(
+            r#"[{"type": "drag", "body": "ball"}, {"type": "drag", "body": "bal"}]"#
+        )),
+        "forces[1].body: no body named 'bal'"
+    );
+    assert_eq!(
+        error(&with_forces(r#"[{"type": "magnet", "body": "ball"}]"#)),
+        "forces[0].type: unknown force type 'magnet' (expected one of: spring, drag, force)"
+    );
+}
+
+#[test]
+fn engine_rules_come_back_with_the_scene_path() {
+    let bodies = r#"{"bodies": [
+        {"shape": {"type": "sphere", "radius": 1}},
+        {"shape": {"type": "sphere", "radius": 1}},
+        {"shape": {"type": "sphere", "radius": 1}},
+        {"shape": {"type": "sphere", "radius": -0.1}}]}"#;
+    assert_eq!(error(bodies), "bodies[3].shape.radius: must be > 0");
+    assert_eq!(
+        error(&one_body(r#""orientation": [0, 0, 0, 0]"#)),
+        "bodies[0].orientation: must be a non-zero quaternion [x, y, z, w]"
+    );
+    assert_eq!(
+        error(&one_body(r#""mass": 0"#)),
+        "bodies[0].mass: must be > 0"
+    );
+    assert_eq!(
+        error(&one_body(r#""density": -5"#)),
+        "bodies[0].density: must be > 0"
+    );
+    assert_eq!(
+        error(&one_body(r#""inertia": [1, 1, 5]"#)),
+        "bodies[0].inertia: violates the triangle inequality: no principal moment may exceed \
+         the sum of the other two"
+    );
+    assert_eq!(
+        error(r#"{"bodies": [{"shape": {"type": "box", "half_extents": [1, 0, 1]}}]}"#),
+        "bodies[0].shape.half_extents: every component must be > 0"
+    );
+    assert_eq!(
+        error(r#"{"bodies": [{"shape": {"type": "compound", "children": []}}]}"#),
+        "bodies[0].shape.children: must not be empty"
+    );
+    assert_eq!(
+        error(&with_forces(
+            r#"[{"type": "spring", "body": "ball", "world_point": [0, 0, 0], "stiffness": -1}]"#
+        )),
+        "forces[0].stiffness: must be >= 0"
+    );
+}
+
+#[test]
+fn a_degenerate_hull_is_reported_under_its_shape() {
+    let flat = r#"{"bodies": [{"shape": {"type": "convex_hull",
+        "points": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]]}}]}"#;
+    let line = error(flat);
+    assert!(line.starts_with("bodies[0].shape.points: "), "{line}");
+    assert_eq!(
+        error(r#"{"bodies": [{"shape": {"type": "convex_hull", "points": [[0, 0]]}}]}"#),
+        "bodies[0].shape.points[0]: expected an array of 3 numbers [x, y, z]"
+    );
+}
+
+#[test]
+fn mass_and_density_together_are_refused() {
+    assert_eq!(
+        error(&one_body(r#""mass": 1, "density": 1000"#)),
+        "bodies[0].density: cannot be given together with mass (give one of mass, density)"
+    );
+}
+
+#[test]
+fn numbers_must_be_finite_and_of_the_right_type() {
+    assert_eq!(
+        error(&one_body(r#""mass": 1e400"#)),
+        "bodies[0].mass: must be a finite number"
+    );
+    assert_eq!(
+        error(&one_body(r#""position": [0, -1e400, 0]"#)),
+        "bodies[0].position[1]: must be a finite number"
+    );
+    assert_eq!(
+        error(&one_body(r#""mass": "1""#)),
+        "bodies[0].mass: expected a number"
+    );
+    assert_eq!(
+        error(&one_body(r#""mass": null"#)),
+        "bodies[0].mass: expected a number"
+    );
+    assert_eq!(
+        error(&one_body(r#""planar": 1"#)),
+        "bodies[0].planar: expected true or false"
+    );
+    assert_eq!(
+        error(&one_body(r#""name": 7"#)),
+        "bodies[0].name: expected a string"
+    );
+    assert_eq!(
+        error(&one_body(r#""position": [0, 1]"#)),
+        "bodies[0].position: expected an array of 3 numbers [x, y, z]"
+    );
+    assert_eq!(
+        error(&one_body(r#""orientation": [0, 0, 1]"#)),
+        "bodies[0].orientation: expected an array of 4 numbers [x, y, z, w]"
+    );
+    assert_eq!(error(r#"{"bodies": {}}"#), "bodies: expected an array");
+    assert_eq!(error(r#"{"bodies": [3]}"#), "bodies[0]: expected an object");
+    assert_eq!(error("[]"), "scene: expected an object");
+    assert_eq!(
+        error(&one_body(r#""inertia": [[1, 0, 0], [0, 1, 0]]"#)),
+        "bodies[0].inertia: expected a 3x3 matrix [[..], [..], [..]] (or 3 principal moments)"
+    );
+    assert_eq!(
+        error(&one_body(r#""inertia": [[1, 0, 0], [0, 1, 0], [0, 0]]"#)),
+        "bodies[0].inertia[2]: expected an array of 3 numbers (a matrix row)"
+    );
+}
+
+#[test]
+fn run_settings_are_checked() {
+    assert_eq!(error(r#"{"dt": 0}"#), "dt: must be > 0");
+    assert_eq!(error(r#"{"dt": -0.01}"#), "dt: must be > 0");
+    assert_eq!(error(r#"{"duration": -1}"#), "duration: must be >= 0");
+    assert_eq!(
+        error(r#"{"gravity": [0, "down", 0]}"#),
+        "gravity[1]: expected a number"
+    );
+    assert_eq!(error(r#"{"name": 3}"#), "name: expected a string");
+}
+
+#[test]
+fn malformed_json_names_the_position() {
+    assert_eq!(
+        error("{\n  \"dt\": 0.01,\n    ,\n}"),
+        "scene: invalid JSON at line 3 column 5: key must be a string"
+    );
+    assert_eq!(
+        error(""),
+        "scene: invalid JSON at line 1 column 0: EOF while parsing a value"
+    );
+}
+
+#[test]
+fn names_must_be_unique_and_not_numbers() {
+    let twice = r#"{"bodies": [
+        {"name": "ball", "shape": {"type": "sphere", "radius": 1}},
+        {"name": "ball", "shape": {"type": "sphere", "radius": 1}}]}"#;
+    assert_eq!(
+        error(twice),
+        "bodies[1].name: a body named 'ball' already exists"
+    );
+    assert_eq!(
+        error(&one_body(r#""name": "12""#)),
+        "bodies[0].name: must not be a plain number (unnamed bodies are labelled by their index)"
+    );
+    assert_eq!(
+        error(&one_body(r#""name": """#)),
+        "bodies[0].name: must not be empty"
+    );
+}
+
+#[test]
+fn a_spring_needs_exactly_one_far_end() {
+    let both = r#"[{"type": "spring", "body": "ball", "world_point": [0, 1, 0], "other": "cup",
+                    "stiffness": 1}]"#;
+    assert_eq!(
+        error(&with_forces(both)),
+        "forces[0].other: cannot be given together with world_point (give exactly one of \
+         world_point, other)"
+    );
+    let neither = r#"[{"type": "spring", "body": "ball", "stiffness": 1}]"#;
+    assert_eq!(
+        error(&with_forces(neither)),
+        "forces[0]: a spring needs world_point or other (give exactly one)"
+    );
+    let stray = r#"[{"type": "spring", "body": "ball", "world_point": [0, 1, 0],
+                     "other_anchor": [0, 0, 0], "stiffness": 1}]"#;
+    assert_eq!(
+        error(&with_forces(stray)),
+        "forces[0].other_anchor: only allowed together with other"
+    );
+    let itself = r#"[{"type": "spring", "body": "ball", "other": "ball", "stiffness": 1}]"#;
+    assert_eq!(
+        error(&with_forces(itself)),
+        "forces[0].other: must be a different body from body"
+    );
+    let unknown = r#"[{"type": "spring", "body": "ball", "other": "cap", "stiffness": 1}]"#;
+    assert_eq!(
+        error(&with_forces(unknown)),
+        "forces[0].other: no body named 'cap'"
+    );
+    let loose = r#"[{"type": "spring", "body": "ball", "world_point": [0, 1, 0]}]"#;
+    assert_eq!(
+        error(&with_forces(loose)),
+        "forces[0].stiffness: missing required key"
+    );
+}
+
+#[test]
+fn missing_required_keys_are_named() {
+    assert_eq!(
+        error(r#"{"bodies": [{}]}"#),
+        "bodies[0].shape: missing required key"
+    );
+    assert_eq!(
+        error(r#"{"bodies": [{"shape": {"radius": 1}}]}"#),
+        "bodies[0].shape.type: missing required key"
+    );
+    assert_eq!(
+        error(r#"{"bodies": [{"shape": {"type": "capsule", "radius": 1}}]}"#),
+        "bodies[0].shape.half_height: missing required key"
+    );
+    assert_eq!(
+        error(&with_forces(r#"[{"type": "drag"}]"#)),
+        "forces[0].body: missing required key"
+    );
+}
+
+#[test]
+fn files_that_cannot_be_read_are_reported() {
+    let e = tumble_scene::load_file("/no/such/scene.json").unwrap_err();
+    assert_eq!(e.field, "scene");
+    assert!(
+        e.reason.starts_with("cannot read '/no/such/scene.json': "),
+        "{e}"
+    );
+    let e = tumble_scene::load("no_such_scene").unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "scene: 'no_such_scene' is neither a built-in scene (free_fall, spring, double_spring, \
+         dzhanibekov, planar_spinner, dumbbell) nor an existing file"
+    );
+}
+
+#[test]
+fn user_text_cannot_break_the_line() {
+    assert_eq!(
+        error(r#"{"du\nration": 1}"#),
+        "du\\nration: unknown key (expected one of: name, description, gravity, dt, duration, \
+         integrator, bodies, forces)"
+    );
+    assert_eq!(error(r#"{"integrator": "rk\n4"}"#).lines().count(), 1);
+    assert_eq!(
+        error(&one_body(r#""name": "a\tb""#)),
+        "bodies[0].name: must not contain control characters"
+    );
+}
+
+#[test]
+fn mass_properties_that_underflow_are_refused() {
+    let tiny = if std::mem::size_of::<tumble::Real>() == 4 {
+        "1e-20"
+    } else {
+        "1e-120"
+    };
+    let line = error(&format!(
+        r#"{{"bodies": [{{"shape": {{"type": "sphere", "radius": {tiny}}}}}]}}"#
+    ));
+    assert!(
+        line.starts_with(
+            "bodies[0].shape: mass and inertia come out zero or infinite at this size (0 kg"
+        ),
+        "{line}"
+    );
+    // A density just inside the float range, times the ball's volume, overflows.
+    let dense = if std::mem::size_of::<tumble::Real>() == 4 {
+        "1e38"
+    } else {
+        "1e308"
+    };
+    let heavy = error(&one_body(&format!(r#""density": {dense}"#)));
+    assert!(
+        heavy.starts_with("bodies[0].density: mass and inertia come out zero or infinite"),
+        "{heavy}"
+    );
+}
