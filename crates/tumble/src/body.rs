@@ -135,6 +135,13 @@ impl Body {
     pub(crate) fn new(def: &BodyDef, shape: Shape) -> Result<Body> {
         validate_def(def)?;
         shape.validate().map_err(|e| e.within("shape"))?;
+        if shape.is_static_only() && def.kind != BodyKind::Static {
+            return Err(Error::invalid(
+                "kind",
+                format!("a {} shape needs a static body", shape.kind_name()),
+            ));
+        }
+        let shape = normalise_plane(shape);
         let orientation = check::rotation("orientation", def.orientation)?;
         let props = mass_properties(def, &shape)?;
         let (moments, axes) = crate::math::symmetric_eigen(props.inertia);
@@ -305,8 +312,25 @@ fn validate_def(def: &BodyDef) -> Result<()> {
     }
 }
 
+/// Planes are stored with a unit normal so every routine can rely on it.
+fn normalise_plane(shape: Shape) -> Shape {
+    match shape {
+        Shape::Plane { normal, offset } => {
+            let len = normal.length();
+            Shape::Plane {
+                normal: normal / len,
+                offset: offset / len,
+            }
+        }
+        other => other,
+    }
+}
+
 /// Mass properties from the shape and the def's density or mass, then the overrides.
 fn mass_properties(def: &BodyDef, shape: &Shape) -> Result<MassProperties> {
+    if shape.is_static_only() {
+        return Ok(shape.mass_properties(1.0));
+    }
     let mut props = match def.mass {
         MassSpec::Density(d) => shape.mass_properties(d),
         MassSpec::Mass(m) => shape.mass_properties(1.0).with_mass(m),

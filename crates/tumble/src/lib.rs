@@ -16,12 +16,16 @@
 
 pub mod analysis;
 pub mod body;
+pub mod broad_phase;
 pub mod diagnostics;
 pub mod error;
 pub mod force;
+pub mod geometry;
 pub mod id;
 pub mod integrate;
 pub mod math;
+pub mod narrow_phase;
+pub mod query;
 pub mod shape;
 pub mod world;
 
@@ -31,10 +35,12 @@ pub use error::{Error, Result};
 pub use force::{
     AppliedForce, Drag, Force, ForceCallback, ForceContext, Spring, SpringEnd, Wrench,
 };
+pub use geometry::{Aabb, Convex, Pose, Ray, RayHit};
 pub use id::{BodyId, ForceId};
 pub use integrate::Integrator;
 pub use math::{Mat3, Quat, Real, Vec3};
-pub use shape::{CompoundChild, ConvexHull, MassProperties, Shape};
+pub use narrow_phase::{ContactPoint, Manifold};
+pub use shape::{CompoundChild, ConvexHull, HeightField, MassProperties, Shape, TriMesh};
 pub use world::{World, WorldDef};
 
 /// Everything a typical user needs, in one import.

@@ -1,11 +1,15 @@
 //! Collision and mass shapes. Each shape is defined in its body's local frame; capsules and
 //! cylinders run along the local y axis.
 
+mod heightfield;
 mod hull;
 mod mass;
+mod trimesh;
 
+pub use heightfield::HeightField;
 pub use hull::ConvexHull;
 pub use mass::MassProperties;
+pub use trimesh::TriMesh;
 
 use crate::error::{check, Error, Result};
 use crate::math::{Quat, Real, Vec3};
@@ -52,6 +56,17 @@ pub enum Shape {
     ConvexHull(ConvexHull),
     /// Several shapes rigidly joined.
     Compound(Vec<CompoundChild>),
+    /// The half-space n·x ≤ offset (body frame): an infinite floor or wall. Static only.
+    Plane {
+        /// Outward unit normal (normalised on validation).
+        normal: Vec3,
+        /// Distance of the surface from the origin along the normal (m).
+        offset: Real,
+    },
+    /// A triangle mesh. Static only.
+    TriMesh(TriMesh),
+    /// A height-field terrain. Static only.
+    HeightField(HeightField),
 }
 
 impl Shape {
@@ -95,7 +110,24 @@ impl Shape {
             Shape::Cylinder { .. } => "cylinder",
             Shape::ConvexHull(_) => "convex_hull",
             Shape::Compound(_) => "compound",
+            Shape::Plane { .. } => "plane",
+            Shape::TriMesh(_) => "trimesh",
+            Shape::HeightField(_) => "heightfield",
         }
+    }
+
+    /// A plane with outward normal `normal` at `offset` along it.
+    pub fn plane(normal: Vec3, offset: Real) -> Shape {
+        Shape::Plane { normal, offset }
+    }
+
+    /// True for shapes without a finite volume or mass (plane, mesh, height field), which
+    /// only static bodies may have.
+    pub fn is_static_only(&self) -> bool {
+        matches!(
+            self,
+            Shape::Plane { .. } | Shape::TriMesh(_) | Shape::HeightField(_)
+        )
     }
 
     /// Checks sizes and nesting; field paths are relative to the shape itself.
@@ -117,14 +149,27 @@ impl Shape {
                 check::positive("radius", *radius)?;
                 check::positive("half_height", *half_height)
             }
-            // A hull is validated when it is built; it cannot exist in a bad state.
-            Shape::ConvexHull(_) => Ok(()),
+            // Hulls, meshes and height fields are validated when built.
+            Shape::ConvexHull(_) | Shape::TriMesh(_) | Shape::HeightField(_) => Ok(()),
+            Shape::Plane { normal, offset } => {
+                check::vec3("normal", *normal)?;
+                if normal.length() < 1e-6 {
+                    return Err(Error::invalid("normal", "must be a non-zero vector"));
+                }
+                check::finite("offset", *offset)
+            }
             Shape::Compound(children) => {
                 if children.is_empty() {
                     return Err(Error::invalid("children", "must not be empty"));
                 }
                 for (i, child) in children.iter().enumerate() {
                     let at = format!("children[{i}]");
+                    if child.shape.is_static_only() {
+                        return Err(Error::invalid(
+                            format!("{at}.shape.type"),
+                            "planes, meshes and height fields cannot be compound children",
+                        ));
+                    }
                     child
                         .shape
                         .validate()
@@ -138,7 +183,8 @@ impl Shape {
     }
 
     /// Mass, centre of mass and inertia tensor (about the centre of mass, in the shape's
-    /// frame) for a uniform `density` (kg/m³). The shape must be valid.
+    /// frame) for a uniform `density` (kg/m³). The shape must be valid. Static-only shapes
+    /// have no volume; they report a unit placeholder that nothing integrates.
     pub fn mass_properties(&self, density: Real) -> MassProperties {
         match self {
             Shape::Sphere { radius } => MassProperties::sphere(density, *radius),
@@ -152,6 +198,9 @@ impl Shape {
                 half_height,
             } => MassProperties::cylinder(density, *radius, *half_height),
             Shape::ConvexHull(hull) => hull.mass_properties(density),
+            Shape::Plane { .. } | Shape::TriMesh(_) | Shape::HeightField(_) => {
+                MassProperties::diagonal(1.0, Vec3::ONE)
+            }
             Shape::Compound(children) => MassProperties::sum(children.iter().map(|c| {
                 c.shape
                     .mass_properties(density)
@@ -188,6 +237,12 @@ impl Shape {
                 .iter()
                 .map(|c| c.position.length() + c.shape.bounding_radius())
                 .fold(0.0, Real::max),
+            Shape::Plane { .. } => Real::INFINITY,
+            Shape::TriMesh(m) => m.vertices().iter().map(|v| v.length()).fold(0.0, Real::max),
+            Shape::HeightField(h) => {
+                let b = h.local_aabb();
+                b.min.length().max(b.max.length())
+            }
         }
     }
 }

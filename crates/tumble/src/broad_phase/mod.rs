@@ -1,0 +1,2 @@
+//! The broad phase: which bodies' bounding boxes overlap.
+//! PLACEHOLDER: being written.

@@ -1,0 +1,116 @@
+//! Axis-aligned bounding boxes.
+
+use crate::math::{Real, Vec3};
+
+/// An axis-aligned box, world or local frame as the context says.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aabb {
+    /// Lower corner (m).
+    pub min: Vec3,
+    /// Upper corner (m).
+    pub max: Vec3,
+}
+
+impl Aabb {
+    /// The box with these corners.
+    pub fn new(min: Vec3, max: Vec3) -> Aabb {
+        Aabb { min, max }
+    }
+
+    /// The box around a centre with half extents.
+    pub fn from_center(center: Vec3, half_extents: Vec3) -> Aabb {
+        Aabb {
+            min: center - half_extents,
+            max: center + half_extents,
+        }
+    }
+
+    /// The smallest box holding every point; `None` for no points.
+    pub fn from_points(points: impl IntoIterator<Item = Vec3>) -> Option<Aabb> {
+        let mut it = points.into_iter();
+        let first = it.next()?;
+        Some(it.fold(Aabb::new(first, first), |b, p| {
+            Aabb::new(b.min.min(p), b.max.max(p))
+        }))
+    }
+
+    /// The box holding both.
+    pub fn union(&self, other: &Aabb) -> Aabb {
+        Aabb {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
+        }
+    }
+
+    /// Grown by `margin` on every side.
+    pub fn expanded(&self, margin: Real) -> Aabb {
+        Aabb {
+            min: self.min - Vec3::splat(margin),
+            max: self.max + Vec3::splat(margin),
+        }
+    }
+
+    /// Whether the boxes share any point (touching counts).
+    #[inline]
+    pub fn overlaps(&self, other: &Aabb) -> bool {
+        self.min.x <= other.max.x
+            && self.max.x >= other.min.x
+            && self.min.y <= other.max.y
+            && self.max.y >= other.min.y
+            && self.min.z <= other.max.z
+            && self.max.z >= other.min.z
+    }
+
+    /// Whether `other` lies entirely inside.
+    pub fn contains(&self, other: &Aabb) -> bool {
+        self.min.cmple(other.min).all() && self.max.cmpge(other.max).all()
+    }
+
+    /// Whether the point lies inside or on the boundary.
+    pub fn contains_point(&self, p: Vec3) -> bool {
+        self.min.cmple(p).all() && self.max.cmpge(p).all()
+    }
+
+    /// Centre.
+    pub fn center(&self) -> Vec3 {
+        (self.min + self.max) * 0.5
+    }
+
+    /// Half the side lengths.
+    pub fn half_extents(&self) -> Vec3 {
+        (self.max - self.min) * 0.5
+    }
+
+    /// Surface area, the cost measure of tree building.
+    pub fn surface_area(&self) -> Real {
+        let d = self.max - self.min;
+        2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
+    }
+
+    /// Entry and exit parameters of the ray `origin + t·dir` through the box (slab test),
+    /// clipped to [0, max_t]; `None` if it misses.
+    pub fn ray_interval(&self, origin: Vec3, dir: Vec3, max_t: Real) -> Option<(Real, Real)> {
+        let mut t0: Real = 0.0;
+        let mut t1 = max_t;
+        for axis in 0..3 {
+            let (o, d, lo, hi) = (origin[axis], dir[axis], self.min[axis], self.max[axis]);
+            if d == 0.0 {
+                if o < lo || o > hi {
+                    return None;
+                }
+                continue;
+            }
+            let inv = 1.0 / d;
+            let (mut a, mut b) = ((lo - o) * inv, (hi - o) * inv);
+            if a > b {
+                std::mem::swap(&mut a, &mut b);
+            }
+            t0 = t0.max(a);
+            t1 = t1.min(b);
+            if t0 > t1 {
+                return None;
+            }
+        }
+        Some((t0, t1))
+    }
+}

@@ -1,0 +1,199 @@
+//! Contact manifolds: what the narrow phase reports and the solver consumes.
+
+use crate::math::{Real, Vec3};
+
+/// Identifies which features of the two shapes made a contact point (a face, edge or
+/// vertex on each), so a point can be recognised in the next step and warm-started.
+/// Pair routines build it with [`feature_id`]; its value has no meaning beyond equality.
+pub type FeatureId = u32;
+
+/// Packs the feature kinds and indices of both shapes into one id.
+/// `kind`s: 0 vertex, 1 edge, 2 face; indices are truncated to 14 bits.
+#[inline]
+pub fn feature_id(kind_a: u32, index_a: u32, kind_b: u32, index_b: u32) -> FeatureId {
+    ((kind_a & 3) << 30) | ((index_a & 0x3fff) << 16) | ((kind_b & 3) << 14) | (index_b & 0x3fff)
+}
+
+/// The same id seen with the shapes swapped.
+#[inline]
+pub fn swap_feature(id: FeatureId) -> FeatureId {
+    (id >> 16) | (id << 16)
+}
+
+/// One point of contact.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ContactPoint {
+    /// The contact point on the surface of shape A, world frame (m).
+    pub point_a: Vec3,
+    /// The contact point on the surface of shape B, world frame (m).
+    pub point_b: Vec3,
+    /// (point_b − point_a) · normal: negative when penetrating (m).
+    pub separation: Real,
+    /// Which features touch.
+    pub feature: FeatureId,
+    /// Normal impulse the solver applied last step (N·s); kept for warm starting.
+    pub normal_impulse: Real,
+    /// Friction impulses along the two tangents last step (N·s).
+    pub tangent_impulse: [Real; 2],
+}
+
+/// Most points a manifold holds: four span any flat contact patch stably.
+pub const MAX_MANIFOLD_POINTS: usize = 4;
+
+/// The contact between two (sub-)shapes: one normal and up to four points.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Manifold {
+    /// Unit normal, world frame, pointing from shape A to shape B.
+    pub normal: Vec3,
+    /// Compound child or triangle index on A (0 for simple shapes).
+    pub subshape_a: u32,
+    /// Compound child or triangle index on B.
+    pub subshape_b: u32,
+    points: [ContactPoint; MAX_MANIFOLD_POINTS],
+    count: u8,
+}
+
+impl Manifold {
+    /// An empty manifold with this normal.
+    pub fn new(normal: Vec3) -> Manifold {
+        Manifold {
+            normal,
+            ..Default::default()
+        }
+    }
+
+    /// The points.
+    pub fn points(&self) -> &[ContactPoint] {
+        &self.points[..self.count as usize]
+    }
+
+    /// The points, mutably.
+    pub fn points_mut(&mut self) -> &mut [ContactPoint] {
+        &mut self.points[..self.count as usize]
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.count as usize
+    }
+
+    /// True with no points.
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    /// Adds a point from the two surface points; the separation is derived along the
+    /// normal. Ignored once the manifold is full (routines reduce before pushing).
+    pub fn push(&mut self, point_a: Vec3, point_b: Vec3, feature: FeatureId) {
+        if (self.count as usize) < MAX_MANIFOLD_POINTS {
+            self.points[self.count as usize] = ContactPoint {
+                point_a,
+                point_b,
+                separation: (point_b - point_a).dot(self.normal),
+                feature,
+                ..Default::default()
+            };
+            self.count += 1;
+        }
+    }
+
+    /// Removes every point.
+    pub fn clear(&mut self) {
+        self.count = 0;
+    }
+
+    /// Keeps only the points for which `keep` is true.
+    pub fn retain(&mut self, mut keep: impl FnMut(&ContactPoint) -> bool) {
+        let mut n = 0;
+        for i in 0..self.count as usize {
+            if keep(&self.points[i]) {
+                self.points[n] = self.points[i];
+                n += 1;
+            }
+        }
+        self.count = n as u8;
+    }
+
+    /// The manifold seen from the other shape: normal flipped, points and features
+    /// swapped.
+    pub fn swapped(&self) -> Manifold {
+        let mut m = *self;
+        m.normal = -self.normal;
+        std::mem::swap(&mut m.subshape_a, &mut m.subshape_b);
+        for p in m.points_mut() {
+            std::mem::swap(&mut p.point_a, &mut p.point_b);
+            p.feature = swap_feature(p.feature);
+        }
+        m
+    }
+
+    /// Deepest (most negative) separation, or +∞ when empty.
+    pub fn min_separation(&self) -> Real {
+        self.points()
+            .iter()
+            .map(|p| p.separation)
+            .fold(Real::INFINITY, Real::min)
+    }
+}
+
+/// A candidate contact before reduction: both surface points and the feature id.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Candidate {
+    /// On shape A, world frame.
+    pub point_a: Vec3,
+    /// On shape B, world frame.
+    pub point_b: Vec3,
+    /// Feature id.
+    pub feature: FeatureId,
+}
+
+/// Fills `out` (whose normal is set) with at most four of `candidates` that keep the
+/// contact patch as large as possible: the deepest point (it carries the most load), the
+/// point farthest from it, the one that makes the largest triangle with those two, and the
+/// one adding the most area beyond that triangle. Candidates deeper than `margin` of
+/// separation are dropped first. Selection ties go to the lower index, so the result is
+/// deterministic.
+pub fn reduce(candidates: &[Candidate], margin: Real, out: &mut Manifold) {
+    let n = out.normal;
+    let sep = |c: &Candidate| (c.point_b - c.point_a).dot(n);
+    let kept: Vec<&Candidate> = candidates.iter().filter(|c| sep(c) <= margin).collect();
+    if kept.len() <= MAX_MANIFOLD_POINTS {
+        for c in kept {
+            out.push(c.point_a, c.point_b, c.feature);
+        }
+        return;
+    }
+    let argmax = |score: &dyn Fn(&Candidate) -> Real| {
+        let mut best = 0;
+        for (i, c) in kept.iter().enumerate() {
+            if score(c) > score(kept[best]) {
+                best = i;
+            }
+        }
+        best
+    };
+    let i0 = argmax(&|c| -sep(c));
+    let p0 = kept[i0].point_a;
+    let i1 = argmax(&|c| (c.point_a - p0).length_squared());
+    let p1 = kept[i1].point_a;
+    let area = |a: Vec3, b: Vec3, c: Vec3| (b - a).cross(c - a).dot(n);
+    let i2 = argmax(&|c| area(p0, p1, c.point_a).abs());
+    let p2 = kept[i2].point_a;
+    // The fourth point lies on the other side of whichever triangle edge it extends most.
+    let sign = area(p0, p1, p2).signum();
+    let i3 = argmax(&|c| {
+        let q = c.point_a;
+        -(sign * area(p0, p1, q))
+            .min(sign * area(p1, p2, q))
+            .min(sign * area(p2, p0, q))
+    });
+    for i in [i0, i1, i2, i3] {
+        if !out
+            .points()
+            .iter()
+            .any(|p| p.feature == kept[i].feature && p.point_a == kept[i].point_a)
+        {
+            out.push(kept[i].point_a, kept[i].point_b, kept[i].feature);
+        }
+    }
+}
