@@ -5,6 +5,7 @@
 //! `bodies[3].shape.radius: must be > 0`; 1 when a run fails part way (a write error).
 
 mod analyze;
+mod contacts;
 mod record;
 mod report;
 mod run;
@@ -47,6 +48,10 @@ enum Command {
     Analyze,
     /// List the built-in scenes with their descriptions.
     Scenes,
+    /// Print the contact points of a scene's initial state as CSV:
+    /// body_a,body_b,x,y,z,nx,ny,nz,separation (normal from body_a to body_b, separation
+    /// in m, negative when penetrating; x,y,z midway between the two surfaces).
+    Contacts(contacts::ContactsArgs),
 }
 
 /// Why the program stops early.
@@ -83,6 +88,7 @@ fn main() -> ExitCode {
         Command::Run(args) => run::run(&args),
         Command::Analyze => analyze::analyze(),
         Command::Scenes => report::list_scenes(),
+        Command::Contacts(args) => contacts::contacts(&args),
     };
     match result {
         Ok(()) | Err(Failure::Closed) => ExitCode::SUCCESS,

@@ -14,6 +14,9 @@ use crate::Failure;
 
 /// Header of the trajectory file.
 pub const TRAJECTORY_HEADER: &str = "time,body,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz";
+/// Header of the contacts file.
+pub const CONTACT_IMPULSES_HEADER: &str =
+    "time,body_a,body_b,x,y,z,nx,ny,nz,normal_impulse,tangent_impulse";
 /// Header of the diagnostics file.
 pub const DIAGNOSTICS_HEADER: &str = "time,kinetic,potential,total,px,py,pz,lx,ly,lz";
 
@@ -114,6 +117,52 @@ impl CsvFile {
         Ok(())
     }
 
+    /// A row per contact point of the last step: bodies, the point midway between the
+    /// surfaces, the normal from body_a to body_b, and the impulses applied over the step
+    /// (N·s; the friction impulse as its magnitude).
+    pub fn contacts(
+        &mut self,
+        time: Real,
+        world: &World,
+        labels: &[String],
+    ) -> Result<(), Failure> {
+        let index: std::collections::BTreeMap<tumble::BodyId, usize> = world
+            .body_ids()
+            .iter()
+            .enumerate()
+            .map(|(i, id)| (*id, i))
+            .collect();
+        let label = |id| {
+            index
+                .get(&id)
+                .and_then(|i| labels.get(*i))
+                .map_or("", String::as_str)
+        };
+        for c in world.contacts() {
+            let n = c.manifold.normal;
+            for p in c.manifold.points() {
+                let m = (p.point_a + p.point_b) * 0.5;
+                self.row(
+                    time,
+                    format_args!(
+                        "{},{},{},{},{},{},{},{},{},{}",
+                        csv_text(label(c.body_a)),
+                        csv_text(label(c.body_b)),
+                        Num(m.x),
+                        Num(m.y),
+                        Num(m.z),
+                        Num(n.x),
+                        Num(n.y),
+                        Num(n.z),
+                        Num(p.total_normal_impulse),
+                        Num(p.total_tangent_impulse.length())
+                    ),
+                )?;
+            }
+        }
+        Ok(())
+    }
+
     /// One row of energies (J) and momenta from `World::diagnostics`.
     pub fn diagnostics(&mut self, time: Real, world: &World) -> Result<(), Failure> {
         let d = world.diagnostics();
@@ -143,7 +192,7 @@ impl CsvFile {
 }
 
 /// A body label as a CSV field: quoted (RFC 4180) only if it needs to be.
-fn csv_text(label: &str) -> std::borrow::Cow<'_, str> {
+pub fn csv_text(label: &str) -> std::borrow::Cow<'_, str> {
     if label.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", label.replace('"', "\"\"")).into()
     } else {

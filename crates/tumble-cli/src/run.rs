@@ -6,7 +6,7 @@ use clap::Args;
 use tumble::{Real, World};
 use tumble_scene::{RunPlan, Scene, SceneError};
 
-use crate::record::{CsvFile, DIAGNOSTICS_HEADER, TRAJECTORY_HEADER};
+use crate::record::{CsvFile, CONTACT_IMPULSES_HEADER, DIAGNOSTICS_HEADER, TRAJECTORY_HEADER};
 use crate::report::{SeedTable, Summary};
 use crate::Failure;
 
@@ -17,7 +17,7 @@ pub const SEED_SCENE: &str = "free_fall";
 #[derive(Args, Debug)]
 pub struct RunArgs {
     /// Scene to run: a built-in name (free_fall, spring, double_spring, dzhanibekov,
-    /// planar_spinner, dumbbell; see `tumble scenes`) or the path of a JSON scene file
+    /// planar_spinner, dumbbell, resting; see `tumble scenes`) or the path of a JSON scene file
     /// (format: docs/scene-format.md). Built-in names win over files in the current
     /// directory. Omitted: the seed's free fall, printed as a table against the analytic
     /// solution.
@@ -54,6 +54,25 @@ pub struct RunArgs {
     #[arg(long, value_name = "FILE")]
     pub diagnostics: Option<PathBuf>,
 
+    /// Write every contact point of every recorded step as CSV to FILE: time (s),
+    /// body_a, body_b, x,y,z (the point midway between the surfaces, m), nx,ny,nz (unit
+    /// normal from body_a to body_b), normal_impulse and tangent_impulse (magnitude),
+    /// applied over that step (N·s).
+    #[arg(long, value_name = "FILE")]
+    pub contacts: Option<PathBuf>,
+
+    /// Contact solver; overrides the scene's `solver`: soft_step (default) or pgs.
+    #[arg(long, value_name = "NAME")]
+    pub solver: Option<String>,
+
+    /// Solver substeps per step; overrides the scene's `substeps`.
+    #[arg(long, value_name = "N")]
+    pub substeps: Option<u32>,
+
+    /// Solver iterations per substep; overrides the scene's `iterations`.
+    #[arg(long, value_name = "N")]
+    pub iterations: Option<u32>,
+
     /// Record every K-th step in the CSV files; step 0 and the last step are always
     /// recorded.
     #[arg(long, value_name = "K", default_value_t = 1)]
@@ -74,6 +93,10 @@ impl Default for RunArgs {
             integrator: None,
             out: None,
             diagnostics: None,
+            contacts: None,
+            solver: None,
+            substeps: None,
+            iterations: None,
             every: 1,
             quiet: false,
         }
@@ -94,10 +117,24 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
     if let Some(integrator) = integrator {
         scene.world.set_integrator(integrator);
     }
+    apply_solver_options(args, &mut scene.world)?;
     let plan = plan(args, &scene)?;
     let mut sinks = Sinks::open(args, &scene, &plan)?;
     step_all(&mut scene.world, &plan, args.every, &mut sinks)?;
     sinks.finish(&scene, &plan)
+}
+
+/// `--solver`, `--substeps`, `--iterations` over the scene's settings.
+fn apply_solver_options(args: &RunArgs, world: &mut World) -> Result<(), Failure> {
+    let mut settings = world.solver_settings();
+    if let Some(name) = &args.solver {
+        settings.kind = tumble_scene::parse_solver(name)?;
+    }
+    settings.substeps = args.substeps.unwrap_or(settings.substeps);
+    settings.iterations = args.iterations.unwrap_or(settings.iterations);
+    world
+        .set_solver_settings(settings)
+        .map_err(|e| Failure::Input(e.to_string()))
 }
 
 /// The command line's duration, steps and dt over the scene's.
@@ -132,6 +169,7 @@ fn step_all(
 struct Sinks {
     trajectory: Option<CsvFile>,
     diagnostics: Option<CsvFile>,
+    contacts: Option<CsvFile>,
     seed_table: Option<SeedTable>,
     summary: Option<Summary>,
     labels: Vec<String>,
@@ -140,8 +178,19 @@ struct Sinks {
 
 impl Sinks {
     fn open(args: &RunArgs, scene: &Scene, plan: &RunPlan) -> Result<Sinks, Failure> {
-        if args.out.is_some() && args.out == args.diagnostics {
-            return Err(SceneError::new("diagnostics", "must be a different file from out").into());
+        let files = [&args.out, &args.diagnostics, &args.contacts];
+        for (i, (name, path)) in ["out", "diagnostics", "contacts"]
+            .iter()
+            .zip(files)
+            .enumerate()
+        {
+            if path.is_some() && files[..i].contains(&path) {
+                return Err(SceneError::new(
+                    *name,
+                    "must be a different file from the other outputs",
+                )
+                .into());
+            }
         }
         let csv = |field, path: &Option<PathBuf>, header| {
             path.as_deref()
@@ -152,6 +201,7 @@ impl Sinks {
         Ok(Sinks {
             trajectory: csv("out", &args.out, TRAJECTORY_HEADER)?,
             diagnostics: csv("diagnostics", &args.diagnostics, DIAGNOSTICS_HEADER)?,
+            contacts: csv("contacts", &args.contacts, CONTACT_IMPULSES_HEADER)?,
             seed_table: seed
                 .then(|| SeedTable::new(&scene.world, plan))
                 .transpose()?,
@@ -171,6 +221,9 @@ impl Sinks {
             if let Some(csv) = &mut self.diagnostics {
                 csv.diagnostics(time, world)?;
             }
+            if let Some(csv) = &mut self.contacts {
+                csv.contacts(time, world, &self.labels)?;
+            }
         }
         if let Some(table) = &mut self.seed_table {
             table.observe(k, time, world)?;
@@ -180,7 +233,10 @@ impl Sinks {
 
     fn finish(self, scene: &Scene, plan: &RunPlan) -> Result<(), Failure> {
         let mut written = Vec::new();
-        for csv in [self.trajectory, self.diagnostics].into_iter().flatten() {
+        for csv in [self.trajectory, self.diagnostics, self.contacts]
+            .into_iter()
+            .flatten()
+        {
             let path = csv.path().display().to_string();
             written.push((path, csv.finish()?));
         }

@@ -429,3 +429,28 @@ fn options_can_rescue_a_scene_too_long_to_run() {
     assert!(ok(&["run", path(&file), "--steps", "2"]).contains("2 steps of dt = 0.01 s"));
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn contacts_lists_every_manifold_point_of_the_initial_state() {
+    let text = ok(&["contacts", "resting"]);
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("body_a,body_b,x,y,z,nx,ny,nz,separation")
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let count = |a: &str, b: &str| rows.iter().filter(|r| r[0] == a && r[1] == b).count();
+    // Box faces give four points, a ball one, a capsule lying down two.
+    assert_eq!(count("ground", "crate"), 4, "{text}");
+    assert_eq!(count("crate", "cube"), 4, "{text}");
+    assert_eq!(count("ground", "ball"), 1, "{text}");
+    assert_eq!(count("ground", "pill"), 2, "{text}");
+    assert_eq!(rows.len(), 11, "{text}");
+    for r in &rows {
+        let n: Vec<f64> = r[5..8].iter().map(|x| num(x)).collect();
+        // Everything rests on something below it: the normals point up, from A to B.
+        assert!((n[1] - 1.0).abs() < TOL, "{r:?}");
+        assert!(num(r[8]).abs() < TOL, "{r:?}");
+    }
+    assert_eq!(refused(&["contacts", "no_such_scene"]).lines().count(), 1);
+}

@@ -5,7 +5,7 @@ use tumble::{BodyDef, BodyKind, InertiaSpec, MassSpec, Mat3, Quat, Shape, Vec3};
 use crate::error::{printable, Result};
 use crate::reader::{Node, Obj};
 
-const BODY_KEYS: [&str; 12] = [
+const BODY_KEYS: [&str; 17] = [
     "name",
     "kind",
     "shape",
@@ -18,6 +18,11 @@ const BODY_KEYS: [&str; 12] = [
     "velocity",
     "angular_velocity",
     "planar",
+    "collision_group",
+    "collision_mask",
+    "friction",
+    "restitution",
+    "bullet",
 ];
 
 /// The body kinds, as scene files name them.
@@ -39,9 +44,21 @@ pub(crate) fn body(node: &Node<'_>) -> Result<(BodyDef, Shape)> {
         inertia: obj.get("inertia").map(|n| inertia(&n)).transpose()?,
         center_of_mass: obj.vec3("center_of_mass")?,
         planar: obj.bool("planar")?.unwrap_or(false),
+        collision_group: bits(&obj, "collision_group")?.unwrap_or(1),
+        collision_mask: bits(&obj, "collision_mask")?.unwrap_or(u32::MAX),
+        friction: obj.real("friction")?.unwrap_or(BodyDef::default().friction),
+        restitution: obj.real("restitution")?.unwrap_or(0.0),
+        bullet: obj.bool("bullet")?.unwrap_or(false),
     };
     let shape = crate::shape::shape(&obj.required("shape")?)?;
     Ok((def, shape))
+}
+
+/// A 32-bit layer mask.
+fn bits(obj: &Obj<'_>, key: &str) -> Result<Option<u32>> {
+    obj.get(key)
+        .map(|n| n.whole(u32::MAX as u64).map(|v| v as u32))
+        .transpose()
 }
 
 /// Names label CSV rows, where unnamed bodies are labelled by their index; a name made

@@ -5,7 +5,7 @@
 //! file in `scenes/` is listed here.
 
 /// Name and JSON text of every built-in scene; the seed's free fall first.
-const SCENES: [(&str, &str); 6] = [
+const SCENES: [(&str, &str); 7] = [
     ("free_fall", include_str!("../../../scenes/free_fall.json")),
     ("spring", include_str!("../../../scenes/spring.json")),
     (
@@ -21,6 +21,7 @@ const SCENES: [(&str, &str); 6] = [
         include_str!("../../../scenes/planar_spinner.json"),
     ),
     ("dumbbell", include_str!("../../../scenes/dumbbell.json")),
+    ("resting", include_str!("../../../scenes/resting.json")),
 ];
 
 /// The JSON text of the built-in scene `name`.

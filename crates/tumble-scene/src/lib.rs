@@ -24,7 +24,7 @@ use std::fmt;
 use std::path::Path;
 
 use serde_json::Value;
-use tumble::{Integrator, Real, Vec3, World, WorldDef};
+use tumble::{Integrator, Real, SolverKind, SolverSettings, Vec3, World, WorldDef};
 
 pub use body::BODY_KINDS;
 pub use builtin::{builtin, builtin_names};
@@ -36,7 +36,7 @@ pub use shape::SHAPE_TYPES;
 
 use reader::{Node, Obj};
 
-const TOP_KEYS: [&str; 8] = [
+const TOP_KEYS: [&str; 15] = [
     "name",
     "description",
     "gravity",
@@ -45,6 +45,13 @@ const TOP_KEYS: [&str; 8] = [
     "integrator",
     "bodies",
     "forces",
+    "solver",
+    "substeps",
+    "iterations",
+    "contact_hertz",
+    "contact_damping_ratio",
+    "length_unit",
+    "sleep",
 ];
 
 /// Default step (s).
@@ -152,12 +159,15 @@ fn build(root: &Node<'_>) -> Result<Scene> {
     let def = WorldDef {
         gravity: obj.vec3("gravity")?.unwrap_or(Vec3::new(0.0, -9.8, 0.0)),
         integrator: integrator(&obj)?,
+        length_unit: obj.real("length_unit")?.unwrap_or(1.0),
+        solver: solver_settings(&obj)?,
+        sleep: obj.bool("sleep")?.unwrap_or(true),
     };
     let dt = obj.real("dt")?.unwrap_or(DEFAULT_DT);
     let duration = obj.real("duration")?.unwrap_or(DEFAULT_DURATION);
     // Checked now, so a bad value is reported as the scene's, not when a run starts.
     plan::check_settings(duration, dt)?;
-    let mut world = World::new(&def);
+    let mut world = World::try_new(&def).map_err(|e| SceneError::from_engine(e, ""))?;
     let body_names = add_bodies(&obj, &mut world)?;
     add_forces(&obj, &mut world)?;
     Ok(Scene {
@@ -167,6 +177,46 @@ fn build(root: &Node<'_>) -> Result<Scene> {
         dt,
         duration,
         body_names,
+    })
+}
+
+/// The solver called `name`, with the scene format's error for any other name.
+pub fn parse_solver(name: &str) -> Result<SolverKind> {
+    SolverKind::from_name(name).ok_or_else(|| {
+        SceneError::new(
+            "solver",
+            format!(
+                "unknown solver '{}' (expected one of: soft_step, pgs)",
+                printable(name)
+            ),
+        )
+    })
+}
+
+/// `solver`, `substeps`, `iterations`, `contact_hertz`, `contact_damping_ratio`. Values are
+/// checked by the engine (`World::try_new`), which names the same keys.
+fn solver_settings(obj: &Obj<'_>) -> Result<SolverSettings> {
+    let d = SolverSettings::default();
+    let count = |key: &str, default: u32| -> Result<u32> {
+        Ok(obj
+            .get(key)
+            .map(|n| n.whole(1_000_000))
+            .transpose()?
+            .map_or(default, |v| v as u32))
+    };
+    Ok(SolverSettings {
+        kind: obj
+            .str("solver")?
+            .map(parse_solver)
+            .transpose()?
+            .unwrap_or(d.kind),
+        substeps: count("substeps", d.substeps)?,
+        iterations: count("iterations", d.iterations)?,
+        contact_hertz: obj.real("contact_hertz")?.unwrap_or(d.contact_hertz),
+        contact_damping_ratio: obj
+            .real("contact_damping_ratio")?
+            .unwrap_or(d.contact_damping_ratio),
+        ..d
     })
 }
 

@@ -69,6 +69,18 @@ impl<'a> Node<'a> {
         }
     }
 
+    /// A whole number in [0, `max`] (indices, bit masks, counts).
+    pub fn whole(&self, max: u64) -> Result<u64> {
+        let Value::Number(n) = self.value else {
+            return Err(self.err("expected a whole number"));
+        };
+        match n.as_u64() {
+            Some(v) if v <= max => Ok(v),
+            Some(_) => Err(self.err(format!("must be at most {max}"))),
+            None => Err(self.err("must be a whole number >= 0")),
+        }
+    }
+
     /// A string.
     pub fn str(&self) -> Result<&'a str> {
         self.value

@@ -38,12 +38,14 @@ fn misspelt_keys_are_refused_with_the_allowed_ones() {
     assert_eq!(
         error(r#"{"gravityy": [0, 0, 0]}"#),
         "gravityy: unknown key (expected one of: name, description, gravity, dt, duration, \
-         integrator, bodies, forces)"
+         integrator, bodies, forces, solver, substeps, iterations, contact_hertz, \
+         contact_damping_ratio, length_unit, sleep)"
     );
     assert_eq!(
         error(&one_body(r#""velocty": [1, 0, 0]"#)),
         "bodies[0].velocty: unknown key (expected one of: name, kind, shape, mass, density, \
-         inertia, center_of_mass, position, orientation, velocity, angular_velocity, planar)"
+         inertia, center_of_mass, position, orientation, velocity, angular_velocity, planar, \
+         collision_group, collision_mask, friction, restitution, bullet)"
     );
     assert_eq!(
         error(&with_forces(
@@ -65,7 +67,7 @@ fn unknown_names_list_the_known_ones() {
     assert_eq!(
         error(r#"{"bodies": [{"shape": {"type": "cone", "radius": 0.1}}]}"#),
         "bodies[0].shape.type: unknown shape type 'cone' (expected one of: sphere, box, capsule, \
-         cylinder, convex_hull, compound)"
+         cylinder, convex_hull, compound, plane, trimesh, heightfield)"
     );
     assert_eq!(
         error(r#"{"integrator": "rk5"}"#),
@@ -308,7 +310,7 @@ fn files_that_cannot_be_read_are_reported() {
     assert_eq!(
         e.to_string(),
         "scene: 'no_such_scene' is neither a built-in scene (free_fall, spring, double_spring, \
-         dzhanibekov, planar_spinner, dumbbell) nor an existing file"
+         dzhanibekov, planar_spinner, dumbbell, resting) nor an existing file"
     );
 }
 
@@ -317,7 +319,8 @@ fn user_text_cannot_break_the_line() {
     assert_eq!(
         error(r#"{"du\nration": 1}"#),
         "du\\nration: unknown key (expected one of: name, description, gravity, dt, duration, \
-         integrator, bodies, forces)"
+         integrator, bodies, forces, solver, substeps, iterations, contact_hertz, \
+         contact_damping_ratio, length_unit, sleep)"
     );
     assert_eq!(error(r#"{"integrator": "rk\n4"}"#).lines().count(), 1);
     assert_eq!(

@@ -10,6 +10,7 @@ fn scene(integrator: Integrator) -> World {
     let mut world = World::new(&WorldDef {
         gravity: Vec3::new(0.0, -9.8, 0.0),
         integrator,
+        ..Default::default()
     });
     let mut previous = None;
     for i in 0..10_000 {

@@ -83,6 +83,17 @@ pub struct BodyDef {
     pub center_of_mass: Option<Vec3>,
     /// Restricts the body to the XY plane, turning only about z (the seed's 2D dynamics).
     pub planar: bool,
+    /// Collision layers the body is in (bits); default layer 1.
+    pub collision_group: u32,
+    /// Layers it collides with (bits); two bodies collide when each one's group meets the
+    /// other's mask. Default: all.
+    pub collision_mask: u32,
+    /// Coulomb friction coefficient (dimensionless); a pair uses √(μ_a μ_b). Default 0.6.
+    pub friction: Real,
+    /// Coefficient of restitution in [0, 1]; a pair uses the larger. Default 0.
+    pub restitution: Real,
+    /// Continuous collision against every body, not only static ones, for fast projectiles.
+    pub bullet: bool,
 }
 
 impl Default for BodyDef {
@@ -98,6 +109,11 @@ impl Default for BodyDef {
             inertia: None,
             center_of_mass: None,
             planar: false,
+            collision_group: 1,
+            collision_mask: u32::MAX,
+            friction: 0.6,
+            restitution: 0.0,
+            bullet: false,
         }
     }
 }
@@ -109,6 +125,18 @@ pub struct Body {
     pub(crate) kind: BodyKind,
     pub(crate) shape: Shape,
     pub(crate) planar: bool,
+    pub(crate) filter: crate::broad_phase::Filter,
+    pub(crate) friction: Real,
+    pub(crate) restitution: Real,
+    pub(crate) bullet: bool,
+    /// Half the body's thinnest extent: moving farther in a step makes it a CCD candidate.
+    pub(crate) ccd_extent: Real,
+    /// False while the body's island sleeps.
+    pub(crate) awake: bool,
+    /// How long the body has been below the sleep thresholds (s).
+    pub(crate) sleep_time: Real,
+    /// The sleeping island the body belongs to.
+    pub(crate) island_tag: u32,
     // Mass properties (dynamic bodies; zero inverse mass otherwise).
     pub(crate) mass: Real,
     pub(crate) inv_mass: Real,
@@ -151,6 +179,17 @@ impl Body {
             kind: def.kind,
             shape,
             planar: def.planar,
+            filter: crate::broad_phase::Filter {
+                group: def.collision_group,
+                mask: def.collision_mask,
+            },
+            friction: def.friction,
+            restitution: def.restitution,
+            bullet: def.bullet,
+            ccd_extent: 0.0,
+            awake: true,
+            sleep_time: 0.0,
+            island_tag: 0,
             mass: props.mass,
             inv_mass: if dynamic { 1.0 / props.mass } else { 0.0 },
             local_center: props.center,
@@ -166,6 +205,7 @@ impl Body {
             angular_momentum: Vec3::ZERO,
             angular_velocity: def.angular_velocity,
         };
+        body.ccd_extent = crate::ccd::ccd_extent(&body.shape);
         let r = Mat3::from_quat(orientation);
         body.planar_inertia = (r * props.inertia * r.transpose()).z_axis.z;
         if body.planar {
@@ -187,6 +227,26 @@ impl Body {
     /// The shape, in the body frame.
     pub fn shape(&self) -> &Shape {
         &self.shape
+    }
+    /// The body's frame as a pose (origin and orientation), which its shape is placed by.
+    pub fn pose(&self) -> crate::geometry::Pose {
+        crate::geometry::Pose::new(self.position(), self.orientation)
+    }
+    /// False while the body's island sleeps.
+    pub fn is_awake(&self) -> bool {
+        self.awake
+    }
+    /// Friction coefficient.
+    pub fn friction(&self) -> Real {
+        self.friction
+    }
+    /// Coefficient of restitution.
+    pub fn restitution(&self) -> Real {
+        self.restitution
+    }
+    /// Collision layers (group) and the layers it collides with (mask).
+    pub fn collision_filter(&self) -> (u32, u32) {
+        (self.filter.group, self.filter.mask)
     }
     /// Whether the body is confined to the XY plane.
     pub fn is_planar(&self) -> bool {
@@ -305,6 +365,11 @@ fn validate_def(def: &BodyDef) -> Result<()> {
     check::vec3("angular_velocity", def.angular_velocity)?;
     if let Some(c) = def.center_of_mass {
         check::vec3("center_of_mass", c)?;
+    }
+    check::non_negative("friction", def.friction)?;
+    check::non_negative("restitution", def.restitution)?;
+    if def.restitution > 1.0 {
+        return Err(Error::invalid("restitution", "must be <= 1"));
     }
     match def.mass {
         MassSpec::Density(d) => check::positive("density", d),

@@ -17,19 +17,25 @@
 pub mod analysis;
 pub mod body;
 pub mod broad_phase;
+pub(crate) mod ccd;
+pub mod contact_cache;
 pub mod diagnostics;
 pub mod error;
 pub mod force;
 pub mod geometry;
 pub mod id;
 pub mod integrate;
+pub(crate) mod island;
 pub mod math;
 pub mod narrow_phase;
 pub mod query;
 pub mod shape;
+pub mod solver;
 pub mod world;
+pub mod world_query;
 
 pub use body::{Body, BodyDef, BodyKind, InertiaSpec, MassSpec};
+pub use contact_cache::{Contact, ContactEvent, ContactEventKind};
 pub use diagnostics::Diagnostics;
 pub use error::{Error, Result};
 pub use force::{
@@ -41,13 +47,15 @@ pub use integrate::Integrator;
 pub use math::{Mat3, Quat, Real, Vec3};
 pub use narrow_phase::{ContactPoint, Manifold};
 pub use shape::{CompoundChild, ConvexHull, HeightField, MassProperties, Shape, TriMesh};
+pub use solver::{SolverKind, SolverSettings};
 pub use world::{World, WorldDef};
+pub use world_query::{QueryFilter, WorldRayHit, WorldShapeHit};
 
 /// Everything a typical user needs, in one import.
 pub mod prelude {
     pub use crate::{
         AppliedForce, Body, BodyDef, BodyId, BodyKind, CompoundChild, Diagnostics, Drag, Error,
         Force, ForceContext, ForceId, InertiaSpec, Integrator, MassSpec, Mat3, Quat, Real, Shape,
-        Spring, SpringEnd, Vec3, World, WorldDef,
+        SolverKind, SolverSettings, Spring, SpringEnd, Vec3, World, WorldDef,
     };
 }

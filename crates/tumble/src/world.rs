@@ -1,6 +1,8 @@
 //! The world: bodies, force elements, and the step that advances them.
 
 use crate::body::{Body, BodyDef, BodyKind};
+use crate::broad_phase::{BroadPhase, ProxyId, ProxyKind};
+use crate::contact_cache::{Contact, ContactCache, ContactEvent};
 use crate::diagnostics::{self, Diagnostics};
 use crate::error::{check, Error, Result};
 use crate::force::{Force, ForceCallback};
@@ -8,6 +10,7 @@ use crate::id::{BodyId, ForceId};
 use crate::integrate::{self, Integrator, Motion, Scratch, System, VerletMemory};
 use crate::math::{Quat, Real, Vec3};
 use crate::shape::Shape;
+use crate::solver::{Scales, Solver, SolverSettings, StepInput};
 
 /// World settings; `Default` is the seed's: g = 9.8 m/s² down the y axis, symplectic Euler.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -16,6 +19,15 @@ pub struct WorldDef {
     pub gravity: Vec3,
     /// The time-stepping method.
     pub integrator: Integrator,
+    /// The length scale of the scene (m): 1 for a scene in metres, 0.01 for one built in
+    /// centimetres. Every tolerance (speculative distance, slop, sleep and bounce
+    /// thresholds, broad-phase margins) is this times its value for metres, so a scene
+    /// behaves the same at any scale.
+    pub length_unit: Real,
+    /// The contact solver.
+    pub solver: SolverSettings,
+    /// Whether resting islands may fall asleep (they wake on any disturbance).
+    pub sleep: bool,
 }
 
 impl Default for WorldDef {
@@ -23,6 +35,39 @@ impl Default for WorldDef {
         WorldDef {
             gravity: Vec3::new(0.0, -9.8, 0.0),
             integrator: Integrator::default(),
+            length_unit: 1.0,
+            solver: SolverSettings::default(),
+            sleep: true,
+        }
+    }
+}
+
+/// Tolerances for a scene whose lengths are in multiples of `length_unit` metres; the
+/// figures are Box2D v3's, which are tuned for metres.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Tolerances {
+    /// Speculative contact distance: gaps narrower than this are contacts already.
+    pub contact_margin: Real,
+    /// How far the broad phase enlarges each box, so slow bodies are not reinserted.
+    pub aabb_margin: Real,
+    /// Solver scales (slop, push-out speed, restitution threshold).
+    pub scales: Scales,
+    /// Speed below which a body counts as resting (m/s).
+    pub sleep_speed: Real,
+}
+
+impl Tolerances {
+    fn new(length_unit: Real) -> Tolerances {
+        let slop = 0.005 * length_unit;
+        Tolerances {
+            contact_margin: 4.0 * slop,
+            aabb_margin: 0.1 * length_unit,
+            scales: Scales {
+                linear_slop: slop,
+                max_push: 3.0 * length_unit,
+                restitution_threshold: 1.0 * length_unit,
+            },
+            sleep_speed: 0.05 * length_unit,
         }
     }
 }
@@ -51,11 +96,40 @@ pub struct World {
     callbacks: Vec<ForceCallback>,
     motions: Vec<Motion>,
     scratch: Scratch,
+    tolerances: Tolerances,
+    solver_settings: SolverSettings,
+    solver: Solver,
+    start: Vec<Motion>,
+    solved: Vec<bool>,
+    sleep_enabled: bool,
+    sleep_tag: u32,
+    pub(crate) broad_phase: BroadPhase,
+    /// One broad-phase proxy per body, in body order.
+    pub(crate) proxies: Vec<ProxyId>,
+    contacts: ContactCache,
 }
 
 impl World {
-    /// An empty world.
+    /// An empty world, after checking the definition.
+    pub fn try_new(def: &WorldDef) -> Result<World> {
+        check::vec3("gravity", def.gravity)?;
+        check::positive("length_unit", def.length_unit)?;
+        let mut world = World::new(def);
+        world.set_solver_settings(def.solver)?;
+        Ok(world)
+    }
+
+    /// An empty world. A non-positive or non-finite `length_unit` is taken as 1 m; use
+    /// [`World::try_new`] to have bad settings refused instead.
     pub fn new(def: &WorldDef) -> World {
+        let def = &WorldDef {
+            length_unit: if def.length_unit.is_finite() && def.length_unit > 0.0 {
+                def.length_unit
+            } else {
+                1.0
+            },
+            ..*def
+        };
         World {
             gravity: def.gravity,
             integrator: def.integrator,
@@ -72,6 +146,16 @@ impl World {
             callbacks: Vec::new(),
             motions: Vec::new(),
             scratch: Scratch::default(),
+            tolerances: Tolerances::new(def.length_unit),
+            solver_settings: def.solver,
+            solver: Solver::default(),
+            start: Vec::new(),
+            solved: Vec::new(),
+            sleep_enabled: def.sleep,
+            sleep_tag: 0,
+            broad_phase: BroadPhase::new(Tolerances::new(def.length_unit).aabb_margin),
+            proxies: Vec::new(),
+            contacts: ContactCache::default(),
         }
     }
 
@@ -103,6 +187,18 @@ impl World {
             index,
             generation: slot.generation,
         };
+        let kind = if body.kind == BodyKind::Static {
+            ProxyKind::Static
+        } else {
+            ProxyKind::Moving
+        };
+        let proxy = self.broad_phase.insert(
+            body.shape.aabb(&body.pose()),
+            self.bodies.len() as u32,
+            kind,
+            body.filter,
+        );
+        self.proxies.push(proxy);
         self.bodies.push(body);
         self.body_ids.push(id);
         self.verlet.push(None);
@@ -115,10 +211,17 @@ impl World {
             field: "body".into(),
             id,
         })?;
+        // Whatever rested on it must notice it is gone.
+        self.wake_around(dense);
         // Keep creation order (outputs list bodies in it); removal is rare.
         self.bodies.remove(dense);
         self.body_ids.remove(dense);
         self.verlet.remove(dense);
+        self.broad_phase.remove(self.proxies.remove(dense));
+        for (i, proxy) in self.proxies.iter().enumerate().skip(dense) {
+            self.broad_phase.set_user(*proxy, i as u32);
+        }
+        self.contacts.forget(id, dense);
         let slot = &mut self.slots[id.index as usize];
         slot.dense = None;
         slot.generation = slot.generation.wrapping_add(1);
@@ -172,9 +275,60 @@ impl World {
         self.body_ids.iter().copied().zip(self.bodies.iter())
     }
 
+    /// The body at dense index `i` (creation order) with its id.
+    pub(crate) fn body_at(&self, i: usize) -> Option<(BodyId, &Body)> {
+        Some((*self.body_ids.get(i)?, self.bodies.get(i)?))
+    }
+
     /// Number of bodies.
     pub fn body_count(&self) -> usize {
         self.bodies.len()
+    }
+
+    /// Wakes body `i`'s island and every island touching it: after an edit nothing that
+    /// rests on it, or that it rests on, may assume the world is unchanged.
+    fn wake_around(&mut self, i: usize) {
+        crate::island::wake_island(&mut self.bodies, i);
+        let touching: Vec<usize> = self
+            .contacts
+            .contacts()
+            .iter()
+            .filter_map(|c| match (c.index_a as usize, c.index_b as usize) {
+                (a, b) if a == i => Some(b),
+                (a, b) if b == i => Some(a),
+                _ => None,
+            })
+            .collect();
+        for j in touching {
+            crate::island::wake_island(&mut self.bodies, j);
+        }
+    }
+
+    /// Wakes a body's island (and the islands touching it).
+    pub fn wake_body(&mut self, id: BodyId) -> Result<()> {
+        let i = self.dense_or_err(id)?;
+        self.wake_around(i);
+        Ok(())
+    }
+
+    /// Turns sleeping on or off; turning it off wakes everything.
+    pub fn set_sleep_enabled(&mut self, enabled: bool) {
+        self.sleep_enabled = enabled;
+        if !enabled {
+            self.wake_all();
+        }
+    }
+
+    /// Whether resting islands may fall asleep.
+    pub fn sleep_enabled(&self) -> bool {
+        self.sleep_enabled
+    }
+
+    fn wake_all(&mut self) {
+        for b in &mut self.bodies {
+            b.awake = true;
+            b.sleep_time = 0.0;
+        }
     }
 
     /// Changes one body's state through `edit`, then re-derives what depends on it.
@@ -192,6 +346,9 @@ impl World {
             omega
         });
         self.verlet[i] = None;
+        let aabb = self.bodies[i].shape.aabb(&self.bodies[i].pose());
+        self.broad_phase.update(self.proxies[i], aabb, Vec3::ZERO);
+        self.wake_around(i);
         Ok(())
     }
 
@@ -227,6 +384,7 @@ impl World {
         let i = self.dense_or_err(id)?;
         self.bodies[i].set_angular_velocity_internal(omega);
         self.verlet[i] = None;
+        self.wake_around(i);
         Ok(())
     }
 
@@ -248,6 +406,7 @@ impl World {
         b.angular_momentum = l;
         b.angular_velocity = b.omega_from_momentum(b.orientation, l);
         self.verlet[i] = None;
+        self.wake_around(i);
         Ok(())
     }
 
@@ -271,6 +430,7 @@ impl World {
         }
         let id = ForceId(self.next_force_id);
         self.next_force_id += 1;
+        self.wake_force_bodies(&force);
         self.forces.push(force);
         self.force_ids.push(id);
         Ok(id)
@@ -280,11 +440,21 @@ impl World {
     pub fn remove_force(&mut self, id: ForceId) -> bool {
         match self.force_ids.iter().position(|f| *f == id) {
             Some(i) => {
-                self.forces.remove(i);
+                let force = self.forces.remove(i);
+                self.wake_force_bodies(&force);
                 self.force_ids.remove(i);
                 true
             }
             None => false,
+        }
+    }
+
+    fn wake_force_bodies(&mut self, force: &Force) {
+        let (a, b) = force.bodies();
+        for id in std::iter::once(a).chain(b) {
+            if let Some(i) = self.dense(id) {
+                self.wake_around(i);
+            }
         }
     }
 
@@ -306,6 +476,9 @@ impl World {
     /// Changes gravity.
     pub fn set_gravity(&mut self, gravity: Vec3) -> Result<()> {
         check::vec3("gravity", gravity)?;
+        if gravity != self.gravity {
+            self.wake_all();
+        }
         self.gravity = gravity;
         Ok(())
     }
@@ -330,12 +503,19 @@ impl World {
         self.step_count
     }
 
-    /// Advances the world by `dt` seconds.
+    /// Advances the world by `dt` seconds: contacts are found at the current state, bodies
+    /// touching nothing advance with the world's integrator alone, bodies in contact go
+    /// through the solver's substeps (see `solver/mod.rs`).
     pub fn step(&mut self, dt: Real) -> Result<()> {
         check::positive("dt", dt)?;
+        self.update_contacts();
+        crate::island::wake_touched(&mut self.bodies, self.contacts.contacts());
         let mut motions = std::mem::take(&mut self.motions);
         motions.clear();
         motions.extend(self.bodies.iter().map(Motion::of));
+        self.start.clear();
+        self.start.extend_from_slice(&motions);
+        self.mark_solved();
         let slots = &self.slots;
         let find = |id: BodyId| lookup(slots, id);
         let mut system = System {
@@ -354,17 +534,136 @@ impl World {
             dt,
             &mut self.scratch,
         );
-        for (body, m) in self.bodies.iter_mut().zip(&motions) {
+        for ((m, start), body) in motions.iter_mut().zip(&self.start).zip(&self.bodies) {
+            if !body.awake {
+                *m = *start;
+            }
+        }
+        if self.solved.iter().any(|s| *s) {
+            for ((m, start), (solved, verlet)) in motions
+                .iter_mut()
+                .zip(&self.start)
+                .zip(self.solved.iter().zip(self.verlet.iter_mut()))
+            {
+                if *solved {
+                    *m = *start;
+                    *verlet = None;
+                }
+            }
+            let input = StepInput {
+                system: &mut system,
+                settings: &self.solver_settings,
+                scales: &self.tolerances.scales,
+                solved: &self.solved,
+                time: self.time,
+                dt,
+            };
+            self.solver
+                .step(input, &mut motions, self.contacts.contacts_mut());
+        }
+        crate::ccd::sweep_fast_bodies(
+            &self.bodies,
+            &self.start,
+            &mut motions,
+            &self.broad_phase,
+            self.tolerances.scales.linear_slop,
+        );
+        self.store_motions(&motions);
+        self.motions = motions;
+        if self.sleep_enabled {
+            crate::island::update_sleep(
+                &mut self.bodies,
+                self.contacts.contacts(),
+                dt,
+                self.tolerances.sleep_speed,
+                &mut self.sleep_tag,
+            );
+        }
+        self.time += dt;
+        self.step_count += 1;
+        Ok(())
+    }
+
+    /// Marks the dynamic bodies that take part in a contact with points.
+    fn mark_solved(&mut self) {
+        self.solved.clear();
+        self.solved.resize(self.bodies.len(), false);
+        for c in self.contacts.contacts() {
+            if c.manifold.is_empty() {
+                continue;
+            }
+            for i in [c.index_a as usize, c.index_b as usize] {
+                if self.bodies[i].kind == BodyKind::Dynamic && self.bodies[i].awake {
+                    self.solved[i] = true;
+                }
+            }
+        }
+    }
+
+    /// Writes the step's results into the bodies and their broad-phase proxies.
+    fn store_motions(&mut self, motions: &[Motion]) {
+        for ((body, m), proxy) in self.bodies.iter_mut().zip(motions).zip(&self.proxies) {
+            if body.kind != BodyKind::Static && body.awake {
+                let moved = m.x - body.com;
+                let pose = crate::geometry::Pose::new(m.x - m.q * body.local_center, m.q);
+                self.broad_phase
+                    .update(*proxy, body.shape.aabb(&pose), moved);
+            }
             body.com = m.x;
             body.orientation = m.q;
             body.velocity = m.v;
             body.angular_momentum = m.l;
             body.angular_velocity = m.w;
         }
-        self.motions = motions;
-        self.time += dt;
-        self.step_count += 1;
+    }
+
+    /// Speculative contact distance (m).
+    pub fn contact_margin(&self) -> Real {
+        self.tolerances.contact_margin
+    }
+
+    /// The solver settings.
+    pub fn solver_settings(&self) -> SolverSettings {
+        self.solver_settings
+    }
+
+    /// Changes the solver settings from the next step on.
+    pub fn set_solver_settings(&mut self, settings: SolverSettings) -> Result<()> {
+        if settings.substeps == 0 {
+            return Err(Error::invalid("substeps", "must be >= 1"));
+        }
+        if settings.iterations == 0 {
+            return Err(Error::invalid("iterations", "must be >= 1"));
+        }
+        check::positive("contact_hertz", settings.contact_hertz)?;
+        check::non_negative("contact_damping_ratio", settings.contact_damping_ratio)?;
+        check::non_negative("baumgarte", settings.baumgarte)?;
+        self.solver_settings = settings;
         Ok(())
+    }
+
+    /// Runs the broad and narrow phases on the current state and returns every contact
+    /// manifold; points keep last update's impulses where their feature ids match.
+    pub fn update_contacts(&mut self) -> &[Contact] {
+        self.contacts.update(
+            &mut self.broad_phase,
+            &self.bodies,
+            &self.body_ids,
+            self.tolerances.contact_margin,
+        );
+        self.contacts.contacts()
+    }
+
+    /// The contacts of the last step (or [`World::update_contacts`]), with the normal and
+    /// friction impulses the solver applied at each point (N·s, per substep).
+    pub fn contacts(&self) -> &[Contact] {
+        self.contacts.contacts()
+    }
+
+    /// Pairs that started or stopped touching at the last contact update (each step
+    /// runs one), plus end events for bodies removed since.
+    pub fn contact_events(&self) -> &[ContactEvent] {
+        self.contacts.events()
     }
 
     /// Energies and momenta of the current state.

@@ -268,4 +268,5 @@ pub(crate) fn advance(
     }
 }
 
+pub(crate) use rotation::{drift as rotor_drift, exact_spin};
 pub(crate) use symplectic::VerletMemory;

@@ -9,12 +9,16 @@
 //! construction.
 
 mod box_box;
+mod clip;
 mod convex;
+mod epa;
+mod gjk;
 mod manifold;
 mod mesh;
 mod plane;
 mod sphere;
 
+pub use convex::{closest_points, ClosestPoints};
 pub use manifold::{
     feature_id, reduce, swap_feature, Candidate, ContactPoint, FeatureId, Manifold,
     MAX_MANIFOLD_POINTS,

@@ -1,15 +1,17 @@
 //! Collision and mass shapes. Each shape is defined in its body's local frame; capsules and
 //! cylinders run along the local y axis.
 
+mod bounds;
 mod heightfield;
 mod hull;
 mod mass;
 mod trimesh;
 
+pub use bounds::{convex_aabb, PLANE_EXTENT};
 pub use heightfield::HeightField;
 pub use hull::ConvexHull;
 pub use mass::MassProperties;
-pub use trimesh::TriMesh;
+pub use trimesh::{EdgeKind, TriMesh, FLAT_EDGE_ANGLE};
 
 use crate::error::{check, Error, Result};
 use crate::math::{Quat, Real, Vec3};

@@ -22,6 +22,7 @@ pub fn world(gravity: Vec3, integrator: Integrator) -> World {
     World::new(&WorldDef {
         gravity,
         integrator,
+        ..Default::default()
     })
 }
 

@@ -1,0 +1,241 @@
+//! Continuous collision detection: bodies that move farther in a step than their own
+//! thickness (or that are flagged `bullet`) are swept from their start to their end pose;
+//! if the sweep hits something first, the body is put back to just before that moment,
+//! keeping its velocity, and next step's speculative contact stops it.
+//!
+//! Fast bodies are swept against static geometry; bullets against every body that is not
+//! itself fast this step (two fast bodies would need each other's sweeps, as in Box2D).
+
+use crate::body::{Body, BodyKind};
+use crate::broad_phase::BroadPhase;
+use crate::geometry::{Convex, Pose};
+use crate::integrate::Motion;
+use crate::math::{quat_from_rotation_vector, Quat, Real, Vec3};
+use crate::query::{time_of_impact, Sweep};
+use crate::shape::Shape;
+
+/// The thickness below which a step's travel counts as fast: half the smallest extent of
+/// the shape's bounding box, or of its thinnest compound child.
+pub(crate) fn ccd_extent(shape: &Shape) -> Real {
+    match shape {
+        Shape::Compound(children) => children
+            .iter()
+            .map(|c| ccd_extent(&c.shape))
+            .fold(Real::INFINITY, Real::min),
+        _ => shape.aabb(&Pose::IDENTITY).half_extents().min_element(),
+    }
+}
+
+/// A body's motion over the step as a sweep of its frame.
+fn sweep_of(body: &Body, start: &Motion, end: &Motion) -> Sweep {
+    let origin = start.x - start.q * body.local_center;
+    Sweep {
+        start: Pose::new(origin, start.q),
+        translation: end.x - start.x,
+        rotation: (end.q * start.q.inverse()).to_scaled_axis(),
+        local_center: body.local_center,
+    }
+}
+
+/// Moves fast bodies of `motions` back to their first time of impact.
+pub(crate) fn sweep_fast_bodies(
+    bodies: &[Body],
+    start: &[Motion],
+    motions: &mut [Motion],
+    broad: &BroadPhase,
+    slop: Real,
+) {
+    let fast: Vec<bool> = bodies
+        .iter()
+        .zip(start.iter().zip(motions.iter()))
+        .map(|(b, (s, m))| {
+            b.kind == BodyKind::Dynamic
+                && b.awake
+                && (b.bullet || (m.x - s.x).length() > b.ccd_extent)
+        })
+        .collect();
+    for i in 0..bodies.len() {
+        if !fast[i] {
+            continue;
+        }
+        let body = &bodies[i];
+        let sweep = sweep_of(body, &start[i], &motions[i]);
+        let end_pose = Pose::new(
+            motions[i].x - motions[i].q * body.local_center,
+            motions[i].q,
+        );
+        let swept = body
+            .shape
+            .aabb(&sweep.start)
+            .union(&body.shape.aabb(&end_pose));
+        let mut first: Real = 1.0;
+        broad.query_aabb(&swept, |user| {
+            let j = user as usize;
+            let Some(other) = bodies.get(j) else { return };
+            let eligible = j != i
+                && !fast[j]
+                && body.filter.allows(&other.filter)
+                && (other.kind == BodyKind::Static
+                    || (body.bullet && other.kind != BodyKind::Static));
+            if eligible {
+                let still = Sweep {
+                    start: other.pose(),
+                    translation: Vec3::ZERO,
+                    rotation: Vec3::ZERO,
+                    local_center: Vec3::ZERO,
+                };
+                first = first.min(shape_toi(
+                    &body.shape,
+                    &sweep,
+                    &other.shape,
+                    &still,
+                    slop,
+                    first,
+                ));
+            }
+        });
+        if first < 1.0 {
+            let (s, m) = (start[i], motions[i]);
+            motions[i].x = s.x + (m.x - s.x) * first;
+            motions[i].q = (quat_from_rotation_vector(sweep.rotation * first) * s.q).normalize();
+            motions[i].w = body.omega_from_momentum(motions[i].q, m.l);
+        }
+    }
+}
+
+/// Earliest impact parameter of a moving shape against a resting one, or `limit`.
+fn shape_toi(a: &Shape, sa: &Sweep, b: &Shape, sb: &Sweep, slop: Real, limit: Real) -> Real {
+    let child_sweep = |s: &Sweep, position: Vec3, orientation: Quat| {
+        let child = s.start.mul(&Pose::new(position, orientation));
+        Sweep {
+            start: child,
+            local_center: Pose::new(position, orientation).inverse_transform_point(s.local_center),
+            ..*s
+        }
+    };
+    match (a, b) {
+        (Shape::Compound(children), _) => children
+            .iter()
+            .map(|c| {
+                shape_toi(
+                    &c.shape,
+                    &child_sweep(sa, c.position, c.orientation),
+                    b,
+                    sb,
+                    slop,
+                    limit,
+                )
+            })
+            .fold(limit, Real::min),
+        (_, Shape::Compound(children)) => children
+            .iter()
+            .map(|c| {
+                shape_toi(
+                    a,
+                    sa,
+                    &c.shape,
+                    &child_sweep(sb, c.position, c.orientation),
+                    slop,
+                    limit,
+                )
+            })
+            .fold(limit, Real::min),
+        (_, Shape::Plane { normal, offset }) => match Convex::from_shape(a) {
+            Some(ca) => plane_toi(
+                &ca,
+                sa,
+                sb.start.transform_vector(*normal),
+                sb.start.position,
+                *offset,
+                slop,
+            )
+            .min(limit),
+            None => limit,
+        },
+        (_, Shape::TriMesh(mesh)) => match Convex::from_shape(a) {
+            Some(ca) => {
+                let mut t = limit;
+                let region = local_region(a, sa, &sb.start);
+                mesh.for_each_triangle_in(&region, |k| {
+                    t = t.min(toi(&ca, sa, &Convex::Triangle(mesh.triangle(k)), sb, slop));
+                });
+                t
+            }
+            None => limit,
+        },
+        (_, Shape::HeightField(field)) => match Convex::from_shape(a) {
+            Some(ca) => {
+                let mut t = limit;
+                let region = local_region(a, sa, &sb.start);
+                field.for_each_triangle_in(&region, |_, tri| {
+                    t = t.min(toi(&ca, sa, &Convex::Triangle(tri), sb, slop));
+                });
+                t
+            }
+            None => limit,
+        },
+        _ => match (Convex::from_shape(a), Convex::from_shape(b)) {
+            (Some(ca), Some(cb)) => toi(&ca, sa, &cb, sb, slop).min(limit),
+            _ => limit,
+        },
+    }
+}
+
+fn toi(a: &Convex, sa: &Sweep, b: &Convex, sb: &Sweep, slop: Real) -> Real {
+    time_of_impact(a, sa, b, sb, slop).map_or(1.0, |hit| hit.t)
+}
+
+/// The swept region of shape `a`, in the frame of the body at `at`.
+fn local_region(a: &Shape, sa: &Sweep, at: &Pose) -> crate::geometry::Aabb {
+    let end = Pose::new(sa.start.position + sa.translation, sa.start.rotation);
+    let world = a
+        .aabb(&sa.start)
+        .union(&a.aabb(&end))
+        .expanded(a.bounding_radius());
+    let corners = (0..8).map(|i| {
+        at.inverse_transform_point(Vec3::new(
+            if i & 1 == 0 { world.min.x } else { world.max.x },
+            if i & 2 == 0 { world.min.y } else { world.max.y },
+            if i & 4 == 0 { world.min.z } else { world.max.z },
+        ))
+    });
+    crate::geometry::Aabb::from_points(corners).unwrap_or(world)
+}
+
+/// Conservative advancement against a half-space n·(x − origin) ≤ offset: the gap of the
+/// deepest point shrinks at most by |n·Δx| + |Δθ|·r per unit of t, so stepping t by
+/// gap / that bound never passes the surface.
+fn plane_toi(a: &Convex, sweep: &Sweep, n: Vec3, origin: Vec3, offset: Real, slop: Real) -> Real {
+    let reach = (0..6)
+        .map(|k| {
+            let mut d = Vec3::ZERO;
+            d[k / 2] = if k % 2 == 0 { 1.0 } else { -1.0 };
+            (a.support(d) - sweep.local_center).length()
+        })
+        .fold(0.0, Real::max);
+    let bound = n.dot(sweep.translation).abs() + sweep.rotation.length() * reach;
+    let mut t: Real = 0.0;
+    for _ in 0..32 {
+        let pose = pose_at(sweep, t);
+        let deepest = pose.transform_point(a.support(pose.inverse_transform_vector(-n)));
+        let gap = n.dot(deepest - origin) - offset;
+        if gap <= slop {
+            return t;
+        }
+        if bound <= 0.0 {
+            return 1.0;
+        }
+        t += (gap - 0.5 * slop) / bound;
+        if t >= 1.0 {
+            return 1.0;
+        }
+    }
+    t
+}
+
+/// The sweep's pose at parameter t: rotation about the centre, then translation.
+fn pose_at(sweep: &Sweep, t: Real) -> Pose {
+    let q = (quat_from_rotation_vector(sweep.rotation * t) * sweep.start.rotation).normalize();
+    let center = sweep.start.transform_point(sweep.local_center) + sweep.translation * t;
+    Pose::new(center - q * sweep.local_center, q)
+}

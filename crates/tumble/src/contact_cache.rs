@@ -1,0 +1,251 @@
+//! Persistent contacts: the narrow phase run over the broad phase's pairs, with every new
+//! manifold point matched by feature id to last step's, so the solver can start from the
+//! impulses it found then (warm starting).
+
+use crate::body::{Body, BodyKind};
+use crate::broad_phase::BroadPhase;
+use crate::id::BodyId;
+use crate::math::{Real, Vec3};
+use crate::narrow_phase::{collide, Manifold};
+
+/// A contact manifold between two bodies.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Contact {
+    /// The first body; the manifold normal points away from it.
+    pub body_a: BodyId,
+    /// The second body.
+    pub body_b: BodyId,
+    /// Points, normal and sub-shapes.
+    pub manifold: Manifold,
+    /// Dense indices of the two bodies when the contact was found.
+    pub(crate) index_a: u32,
+    pub(crate) index_b: u32,
+}
+
+impl Contact {
+    /// Identity of the contact across steps: the bodies and sub-shapes involved.
+    fn key(&self) -> (BodyId, BodyId, u32, u32) {
+        (
+            self.body_a,
+            self.body_b,
+            self.manifold.subshape_a,
+            self.manifold.subshape_b,
+        )
+    }
+}
+
+/// Whether two bodies started or stopped touching.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactEventKind {
+    /// The pair has contact points now and had none at the previous update.
+    Begin,
+    /// The pair had contact points at the previous update and has none now.
+    End,
+}
+
+/// A change in which bodies touch, between two contact updates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ContactEvent {
+    /// Begin or end.
+    pub kind: ContactEventKind,
+    /// The first body (lower creation order).
+    pub body_a: BodyId,
+    /// The second body.
+    pub body_b: BodyId,
+}
+
+/// The current contacts and the previous step's, for matching.
+#[derive(Debug, Default)]
+pub(crate) struct ContactCache {
+    contacts: Vec<Contact>,
+    previous: Vec<Contact>,
+    events: Vec<ContactEvent>,
+    pairs: Vec<(u32, u32)>,
+    manifolds: Vec<Manifold>,
+}
+
+impl ContactCache {
+    /// The contacts found by the last update, ordered by body pair.
+    pub fn contacts(&self) -> &[Contact] {
+        &self.contacts
+    }
+
+    /// Recomputes every contact from the broad phase's pairs. Pairs in which neither body
+    /// is dynamic are skipped: nothing could respond to them.
+    pub fn update(
+        &mut self,
+        broad: &mut BroadPhase,
+        bodies: &[Body],
+        ids: &[BodyId],
+        margin: Real,
+    ) {
+        broad.pairs(&mut self.pairs);
+        std::mem::swap(&mut self.contacts, &mut self.previous);
+        self.previous.sort_by_key(Contact::key);
+        self.contacts.clear();
+        for &(a, b) in &self.pairs {
+            let (a, b) = (a as usize, b as usize);
+            let (Some(body_a), Some(body_b)) = (bodies.get(a), bodies.get(b)) else {
+                continue;
+            };
+            if body_a.kind != BodyKind::Dynamic && body_b.kind != BodyKind::Dynamic {
+                continue;
+            }
+            // A sleeping island costs nothing: between bodies that cannot have moved, last
+            // step's manifolds still hold.
+            let frozen =
+                |b: &Body| b.kind == BodyKind::Static || (b.kind == BodyKind::Dynamic && !b.awake);
+            if frozen(body_a) && frozen(body_b) {
+                keep_previous(&self.previous, ids[a], ids[b], a, b, &mut self.contacts);
+                continue;
+            }
+            self.manifolds.clear();
+            collide(
+                &body_a.shape,
+                &body_a.pose(),
+                &body_b.shape,
+                &body_b.pose(),
+                margin,
+                &mut self.manifolds,
+            );
+            for manifold in &self.manifolds {
+                let mut contact = Contact {
+                    body_a: ids[a],
+                    body_b: ids[b],
+                    manifold: *manifold,
+                    index_a: a as u32,
+                    index_b: b as u32,
+                };
+                warm_start(&mut contact, &self.previous);
+                self.contacts.push(contact);
+            }
+        }
+        self.find_events();
+    }
+
+    /// Begin and end events since the previous update, by body pair.
+    pub fn events(&self) -> &[ContactEvent] {
+        &self.events
+    }
+
+    fn find_events(&mut self) {
+        let touching = |list: &[Contact]| {
+            let mut pairs: Vec<(BodyId, BodyId)> = list
+                .iter()
+                .filter(|c| !c.manifold.is_empty())
+                .map(|c| (c.body_a, c.body_b))
+                .collect();
+            pairs.sort();
+            pairs.dedup();
+            pairs
+        };
+        let (now, before) = (touching(&self.contacts), touching(&self.previous));
+        self.events.clear();
+        for &(a, b) in &now {
+            if before.binary_search(&(a, b)).is_err() {
+                self.events.push(ContactEvent {
+                    kind: ContactEventKind::Begin,
+                    body_a: a,
+                    body_b: b,
+                });
+            }
+        }
+        for &(a, b) in &before {
+            if now.binary_search(&(a, b)).is_err() {
+                self.events.push(ContactEvent {
+                    kind: ContactEventKind::End,
+                    body_a: a,
+                    body_b: b,
+                });
+            }
+        }
+    }
+
+    /// The contacts, for the solver to store impulses in.
+    pub fn contacts_mut(&mut self) -> &mut [Contact] {
+        &mut self.contacts
+    }
+
+    /// Forgets every contact of a removed body that stood at dense index `index`, and
+    /// renumbers the bodies after it.
+    pub fn forget(&mut self, id: BodyId, index: usize) {
+        for c in self
+            .contacts
+            .iter()
+            .filter(|c| (c.body_a == id || c.body_b == id) && !c.manifold.is_empty())
+        {
+            let event = ContactEvent {
+                kind: ContactEventKind::End,
+                body_a: c.body_a,
+                body_b: c.body_b,
+            };
+            if !self.events.contains(&event) {
+                self.events.push(event);
+            }
+        }
+        self.contacts.retain(|c| c.body_a != id && c.body_b != id);
+        let shift = |i: &mut u32| {
+            if *i as usize > index {
+                *i -= 1;
+            }
+        };
+        for c in &mut self.contacts {
+            shift(&mut c.index_a);
+            shift(&mut c.index_b);
+        }
+        self.previous.clear();
+    }
+}
+
+/// Carries the previous contacts of the pair (a, b) over unchanged.
+fn keep_previous(
+    previous: &[Contact],
+    id_a: BodyId,
+    id_b: BodyId,
+    a: usize,
+    b: usize,
+    out: &mut Vec<Contact>,
+) {
+    let start = previous.partition_point(|c| (c.body_a, c.body_b) < (id_a, id_b));
+    for c in previous[start..]
+        .iter()
+        .take_while(|c| (c.body_a, c.body_b) == (id_a, id_b))
+    {
+        out.push(Contact {
+            index_a: a as u32,
+            index_b: b as u32,
+            ..*c
+        });
+    }
+}
+
+/// Copies last step's impulses onto this step's points: by feature id, or, for a point
+/// whose features were renamed (a pair routine may pick the other box's face as reference
+/// from one step to the next), by proximity — the old point within `MATCH_DISTANCE` of it.
+/// Losing warm starts on a resting stack would restart its solution from zero each time.
+fn warm_start(contact: &mut Contact, previous: &[Contact]) {
+    let Ok(i) = previous.binary_search_by_key(&contact.key(), Contact::key) else {
+        return;
+    };
+    let old = &previous[i].manifold;
+    let mid = |a: Vec3, b: Vec3| (a + b) * 0.5;
+    for p in contact.manifold.points_mut() {
+        let here = mid(p.point_a, p.point_b);
+        let by_feature = old.points().iter().find(|q| q.feature == p.feature);
+        let by_place = || {
+            old.points()
+                .iter()
+                .map(|q| (q, (mid(q.point_a, q.point_b) - here).length_squared()))
+                .filter(|(_, d2)| *d2 < MATCH_DISTANCE * MATCH_DISTANCE)
+                .min_by(|x, y| x.1.total_cmp(&y.1))
+                .map(|(q, _)| q)
+        };
+        if let Some(q) = by_feature.or_else(by_place) {
+            p.normal_impulse = q.normal_impulse;
+            p.tangent_impulse = q.tangent_impulse;
+        }
+    }
+}
+
+/// How close an unnamed point must be to last step's to inherit its impulses (m).
+const MATCH_DISTANCE: Real = 0.01;

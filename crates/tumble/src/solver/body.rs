@@ -1,0 +1,110 @@
+//! The solver's view of a body, split as in Box2D v3: a small `BodyState` that every
+//! constraint pass reads and writes (velocities and the motion since the step began), and
+//! a `BodySim` with what changes only between substeps.
+
+use crate::body::{Body, BodyKind};
+use crate::integrate::Motion;
+use crate::math::{Mat3, Quat, Real, Vec3};
+
+/// What constraint passes touch: kept small and contiguous.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BodyState {
+    pub v: Vec3,
+    pub w: Vec3,
+    /// Displacement of the centre of mass since the step began.
+    pub dp: Vec3,
+    /// Rotation since the step began.
+    pub dr: Mat3,
+}
+
+impl BodyState {
+    /// Displacement of the material point that was at offset `r` when the step began.
+    #[inline]
+    pub fn point_displacement(&self, r: Vec3) -> Vec3 {
+        self.dp + self.dr * r - r
+    }
+}
+
+/// The rest of a body's solver data.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BodySim {
+    pub x: Vec3,
+    pub q: Quat,
+    pub x0: Vec3,
+    pub q0: Quat,
+    /// Angular momentum, the integrated rotational state.
+    pub l: Vec3,
+    /// ω at which `l` was last brought up to date (see [`BodySim::sync_momentum`]).
+    pub w_synced: Vec3,
+    pub inv_mass: Real,
+    /// Which linear directions an impulse may change (planar bodies lose z).
+    pub linear_mask: Vec3,
+    /// World inertia and its inverse at the step's start: impulses are applied with them
+    /// for the whole step, as in Rapier and Jolt, so prepared effective masses stay valid.
+    pub inertia: Mat3,
+    pub inv_inertia: Mat3,
+    /// True for awake dynamic bodies the solver moves.
+    pub moves: bool,
+}
+
+impl BodySim {
+    pub fn new(body: &Body, m: &Motion, solved: bool) -> (BodySim, BodyState) {
+        let moves = solved && body.kind == BodyKind::Dynamic;
+        let (inertia, inv_inertia) = if !moves {
+            (Mat3::ZERO, Mat3::ZERO)
+        } else if body.planar {
+            let i = body.planar_inertia;
+            (
+                Mat3::from_diagonal(Vec3::new(0.0, 0.0, i)),
+                Mat3::from_diagonal(Vec3::new(0.0, 0.0, 1.0 / i)),
+            )
+        } else {
+            let r = Mat3::from_quat(m.q);
+            (
+                r * body.inertia_local * r.transpose(),
+                r * body.inv_inertia_local * r.transpose(),
+            )
+        };
+        let sim = BodySim {
+            x: m.x,
+            q: m.q,
+            x0: m.x,
+            q0: m.q,
+            l: m.l,
+            w_synced: m.w,
+            inv_mass: if moves { body.inv_mass } else { 0.0 },
+            linear_mask: if body.planar {
+                Vec3::new(1.0, 1.0, 0.0)
+            } else {
+                Vec3::ONE
+            },
+            inertia,
+            inv_inertia,
+            moves,
+        };
+        let state = BodyState {
+            v: m.v,
+            w: m.w,
+            dp: Vec3::ZERO,
+            dr: Mat3::IDENTITY,
+        };
+        (sim, state)
+    }
+
+    /// Impulses changed ω by I₀⁻¹ ΣΔL; the same ΣΔL goes into L: ΔL = I₀ (ω − ω_synced).
+    #[inline]
+    pub fn sync_momentum(&mut self, state: &BodyState) {
+        if self.moves {
+            self.l += self.inertia * (state.w - self.w_synced);
+            self.w_synced = state.w;
+        }
+    }
+
+    /// The inverse effective mass of this body along direction `n` at offset `r`:
+    /// n·M⁻¹n + (r×n)·I⁻¹(r×n).
+    #[inline]
+    pub fn inverse_mass_along(&self, n: Vec3, r: Vec3) -> Real {
+        let rn = r.cross(n);
+        self.inv_mass * (self.linear_mask * n).dot(n) + rn.dot(self.inv_inertia * rn)
+    }
+}

@@ -1,0 +1,311 @@
+//! The constraint solver: contacts (and, later, joints) as impulses inside substeps.
+//!
+//! One step of `dt` with n substeps of h = dt/n, for the bodies that touch something:
+//!
+//! ```text
+//! prepare constraints (anchors, effective masses, last step's impulses)
+//! repeat n times:
+//!     kick      v += h F/m, L += h N            forces at the substep's state
+//!     warm start: apply the accumulated impulses
+//!     solve     (iterations passes, with position bias: soft spring or Baumgarte)
+//!     drift     x += h v, q by the rotor splitting with L (exact torque-free turning)
+//!     relax     (soft step only: passes without bias, removing the push-out velocity)
+//! restitution, then store impulses for the next step's warm start
+//! ```
+//!
+//! This is Box2D v3's soft step (Catto 2024) carried to 3D, with angular momentum as the
+//! integrated rotational state so that constrained bodies tumble as correctly as free ones.
+
+mod body;
+mod contact;
+mod softness;
+
+pub use softness::Softness;
+
+use body::{BodySim, BodyState};
+use contact::{BiasRule, ContactConstraint};
+
+use crate::body::{Body, BodyKind};
+use crate::contact_cache::Contact;
+use crate::force::Wrench;
+use crate::integrate::{exact_spin, rotor_drift, Motion, System};
+use crate::math::{Mat3, Real};
+
+/// Which velocity solver handles contacts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SolverKind {
+    /// Substepped soft constraints with relax and restitution passes (the default).
+    #[default]
+    SoftStep,
+    /// Classic projected Gauss–Seidel sequential impulses with Baumgarte correction.
+    Pgs,
+}
+
+impl SolverKind {
+    /// The name used in scene files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverKind::SoftStep => "soft_step",
+            SolverKind::Pgs => "pgs",
+        }
+    }
+    /// The kind called `name`.
+    pub fn from_name(name: &str) -> Option<SolverKind> {
+        [SolverKind::SoftStep, SolverKind::Pgs]
+            .into_iter()
+            .find(|k| k.name() == name)
+    }
+}
+
+/// Solver settings; `Default` is the soft step with 4 substeps and 1 iteration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverSettings {
+    /// Soft step or PGS.
+    pub kind: SolverKind,
+    /// Substeps per step.
+    pub substeps: u32,
+    /// Solve passes per substep (and relax passes, for the soft step).
+    pub iterations: u32,
+    /// Contact stiffness (Hz), capped at a quarter of the substep rate.
+    pub contact_hertz: Real,
+    /// Contact damping ratio (dimensionless).
+    pub contact_damping_ratio: Real,
+    /// Baumgarte factor for PGS (fraction of the error corrected per substep).
+    pub baumgarte: Real,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        SolverSettings {
+            kind: SolverKind::SoftStep,
+            substeps: 4,
+            iterations: 1,
+            contact_hertz: 60.0,
+            contact_damping_ratio: 10.0,
+            baumgarte: 0.2,
+        }
+    }
+}
+
+/// Lengths and speeds the solver works with, all scaled from the world's length unit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Scales {
+    pub linear_slop: Real,
+    pub max_push: Real,
+    pub restitution_threshold: Real,
+}
+
+/// What the solver needs of a step.
+pub(crate) struct StepInput<'a, 'b> {
+    pub system: &'a mut System<'b>,
+    pub settings: &'a SolverSettings,
+    pub scales: &'a Scales,
+    /// Which bodies the solver advances (dynamic bodies touching something).
+    pub solved: &'a [bool],
+    pub time: Real,
+    pub dt: Real,
+}
+
+/// Buffers reused from step to step.
+#[derive(Default)]
+pub(crate) struct Solver {
+    sims: Vec<BodySim>,
+    states: Vec<BodyState>,
+    constraints: Vec<ContactConstraint>,
+    wrench: Vec<Wrench>,
+    motions: Vec<Motion>,
+}
+
+impl Solver {
+    /// Advances the solved bodies of `motions` (their start-of-step states) through the
+    /// step, and writes every contact's impulses back.
+    pub fn step(
+        &mut self,
+        input: StepInput<'_, '_>,
+        motions: &mut [Motion],
+        contacts: &mut [Contact],
+    ) {
+        let bodies = input.system.bodies;
+        let substeps = input.settings.substeps.max(1);
+        let h = input.dt / substeps as Real;
+        self.sims.clear();
+        self.states.clear();
+        for ((b, m), &solved) in bodies.iter().zip(motions.iter()).zip(input.solved) {
+            let (sim, state) = BodySim::new(b, m, solved);
+            self.sims.push(sim);
+            self.states.push(state);
+        }
+        let rule = bias_rule(input.settings, input.scales, h);
+        self.prepare(bodies, contacts, &rule);
+        for i in 0..substeps {
+            self.kick(input.system, input.time + i as Real * h, h);
+            for c in &self.constraints {
+                c.warm_start(&mut self.states);
+            }
+            for _ in 0..input.settings.iterations {
+                for c in &mut self.constraints {
+                    c.solve(&mut self.states, &rule, true);
+                }
+            }
+            self.drift(bodies, h);
+            if input.settings.kind == SolverKind::SoftStep {
+                for _ in 0..input.settings.iterations {
+                    for c in &mut self.constraints {
+                        c.solve(&mut self.states, &rule, false);
+                    }
+                }
+            }
+            for c in &mut self.constraints {
+                c.add_to_totals();
+            }
+        }
+        for c in &mut self.constraints {
+            c.restitution(&mut self.states, input.scales.restitution_threshold);
+            c.store_impulses(&mut contacts[c.contact]);
+        }
+        for ((m, sim), (state, body)) in motions
+            .iter_mut()
+            .zip(&mut self.sims)
+            .zip(self.states.iter().zip(bodies))
+        {
+            if sim.moves {
+                sim.sync_momentum(state);
+                *m = Motion {
+                    x: sim.x,
+                    q: sim.q,
+                    v: state.v,
+                    l: sim.l,
+                    w: body.omega_from_momentum(sim.q, sim.l),
+                };
+            }
+        }
+    }
+
+    fn prepare(&mut self, bodies: &[Body], contacts: &[Contact], rule: &BiasRule) {
+        self.constraints.clear();
+        for (i, c) in contacts.iter().enumerate() {
+            let (a, b) = (c.index_a as usize, c.index_b as usize);
+            if c.manifold.is_empty() || !(self.sims[a].moves || self.sims[b].moves) {
+                continue;
+            }
+            let friction = (bodies[a].friction * bodies[b].friction).sqrt();
+            let restitution = bodies[a].restitution.max(bodies[b].restitution);
+            self.constraints.push(ContactConstraint::prepare(
+                i,
+                c,
+                (a, b),
+                &self.sims,
+                &self.states,
+                rule,
+                (friction, restitution),
+            ));
+        }
+        self.order_by_colour();
+    }
+
+    /// Orders the constraints so that neighbours in the list rarely share a moving body
+    /// (greedy graph colouring, colour by colour). Gauss–Seidel passes are a chain of
+    /// dependent updates; constraints on disjoint bodies let the processor overlap them.
+    /// Deterministic: colours depend only on the constraint order, itself deterministic.
+    fn order_by_colour(&mut self) {
+        let mut used = vec![0u64; self.sims.len()];
+        let mut colours = Vec::with_capacity(self.constraints.len());
+        for c in &self.constraints {
+            let (a, b) = c.body_pair();
+            let mask = |i: usize| if self.sims[i].moves { used[i] } else { 0 };
+            let colour = (!(mask(a) | mask(b))).trailing_zeros().min(63);
+            for i in [a, b] {
+                if self.sims[i].moves {
+                    used[i] |= 1u64 << colour;
+                }
+            }
+            colours.push(colour);
+        }
+        let mut order: Vec<usize> = (0..self.constraints.len()).collect();
+        order.sort_by_key(|&i| colours[i]);
+        let sorted: Vec<ContactConstraint> =
+            order.iter().map(|&i| self.constraints[i].clone()).collect();
+        self.constraints = sorted;
+    }
+
+    /// v += h F/m, L += h N for the solved bodies, forces taken at the current substep.
+    fn kick(&mut self, system: &mut System<'_>, t: Real, h: Real) {
+        self.motions.clear();
+        self.motions
+            .extend(self.sims.iter().zip(&self.states).map(|(s, st)| Motion {
+                x: s.x,
+                q: s.q,
+                v: st.v,
+                l: s.l,
+                w: st.w,
+            }));
+        self.wrench.resize(self.motions.len(), Wrench::default());
+        system.wrenches(t, &self.motions, &mut self.wrench);
+        for (((sim, state), w), body) in self
+            .sims
+            .iter_mut()
+            .zip(&mut self.states)
+            .zip(&self.wrench)
+            .zip(system.bodies)
+        {
+            if sim.moves {
+                sim.sync_momentum(state);
+                state.v += sim.linear_mask * w.force * (sim.inv_mass * h);
+                sim.l += w.torque * h;
+                state.w = body.omega_from_momentum(sim.q, sim.l);
+                sim.w_synced = state.w;
+            }
+        }
+    }
+
+    /// x += h v and the exact torque-free rotation with L; kinematic bodies move too, so
+    /// contacts see them where they are.
+    fn drift(&mut self, bodies: &[Body], h: Real) {
+        for ((sim, state), body) in self.sims.iter_mut().zip(&mut self.states).zip(bodies) {
+            match (sim.moves, body.kind) {
+                (true, _) => {
+                    sim.sync_momentum(state);
+                    sim.x += state.v * h;
+                    sim.q = rotor_drift(body, sim.q, sim.l, state.w, h);
+                    state.w = body.omega_from_momentum(sim.q, sim.l);
+                    sim.w_synced = state.w;
+                }
+                (false, BodyKind::Kinematic) => {
+                    sim.x += state.v * h;
+                    sim.q = exact_spin(state.w, sim.q, h);
+                }
+                _ => continue,
+            }
+            state.dp = sim.x - sim.x0;
+            state.dr = Mat3::from_quat(sim.q * sim.q0.inverse());
+        }
+    }
+}
+
+/// The soft spring for the soft step (capped at a quarter of the substep rate, as in
+/// Box2D); the rigid row with Baumgarte's β/h for PGS.
+fn bias_rule(settings: &SolverSettings, scales: &Scales, h: Real) -> BiasRule {
+    let inv_h = 1.0 / h;
+    BiasRule {
+        h,
+        inv_h,
+        spring: (settings.kind == SolverKind::SoftStep).then(|| {
+            (
+                settings.contact_hertz.min(0.25 * inv_h),
+                settings.contact_damping_ratio,
+            )
+        }),
+        baumgarte: Softness {
+            bias_rate: settings.baumgarte * inv_h,
+            mass_scale: 1.0,
+            impulse_scale: 0.0,
+        },
+        slop: if settings.kind == SolverKind::Pgs {
+            scales.linear_slop
+        } else {
+            0.0
+        },
+        max_push: scales.max_push,
+        slip_speed: scales.linear_slop,
+    }
+}
