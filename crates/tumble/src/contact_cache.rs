@@ -59,6 +59,9 @@ pub struct ContactEvent {
 pub(crate) struct ContactCache {
     contacts: Vec<Contact>,
     previous: Vec<Contact>,
+    /// Indices of `previous` sorted by contact key: sorting indices moves 4 bytes each
+    /// where sorting the contacts would move hundreds.
+    order: Vec<u32>,
     events: Vec<ContactEvent>,
     pairs: Vec<(u32, u32)>,
     manifolds: Vec<Manifold>,
@@ -81,7 +84,14 @@ impl ContactCache {
     ) {
         broad.pairs(&mut self.pairs);
         std::mem::swap(&mut self.contacts, &mut self.previous);
-        self.previous.sort_by_key(Contact::key);
+        self.order.clear();
+        self.order.extend(0..self.previous.len() as u32);
+        let previous = &self.previous;
+        self.order.sort_by_key(|&i| previous[i as usize].key());
+        let old = Sorted {
+            list: &self.previous,
+            order: &self.order,
+        };
         self.contacts.clear();
         for &(a, b) in &self.pairs {
             let (a, b) = (a as usize, b as usize);
@@ -96,7 +106,7 @@ impl ContactCache {
             let frozen =
                 |b: &Body| b.kind == BodyKind::Static || (b.kind == BodyKind::Dynamic && !b.awake);
             if frozen(body_a) && frozen(body_b) {
-                keep_previous(&self.previous, ids[a], ids[b], a, b, &mut self.contacts);
+                keep_previous(&old, ids[a], ids[b], a, b, &mut self.contacts);
                 continue;
             }
             self.manifolds.clear();
@@ -116,7 +126,7 @@ impl ContactCache {
                     index_a: a as u32,
                     index_b: b as u32,
                 };
-                warm_start(&mut contact, &self.previous);
+                warm_start(&mut contact, &old);
                 self.contacts.push(contact);
             }
         }
@@ -197,20 +207,47 @@ impl ContactCache {
     }
 }
 
+/// Last step's contacts, searchable by key.
+struct Sorted<'a> {
+    list: &'a [Contact],
+    order: &'a [u32],
+}
+
+impl Sorted<'_> {
+    fn at(&self, k: usize) -> &Contact {
+        &self.list[self.order[k] as usize]
+    }
+
+    /// The contact with exactly this key.
+    fn find(&self, key: (BodyId, BodyId, u32, u32)) -> Option<&Contact> {
+        let k = self
+            .order
+            .partition_point(|&i| self.list[i as usize].key() < key);
+        (k < self.order.len() && self.at(k).key() == key).then(|| self.at(k))
+    }
+
+    /// Every contact between the two bodies, in key order.
+    fn pair(&self, a: BodyId, b: BodyId) -> impl Iterator<Item = &Contact> {
+        let k = self.order.partition_point(|&i| {
+            let c = &self.list[i as usize];
+            (c.body_a, c.body_b) < (a, b)
+        });
+        (k..self.order.len())
+            .map(|k| self.at(k))
+            .take_while(move |c| (c.body_a, c.body_b) == (a, b))
+    }
+}
+
 /// Carries the previous contacts of the pair (a, b) over unchanged.
 fn keep_previous(
-    previous: &[Contact],
+    previous: &Sorted<'_>,
     id_a: BodyId,
     id_b: BodyId,
     a: usize,
     b: usize,
     out: &mut Vec<Contact>,
 ) {
-    let start = previous.partition_point(|c| (c.body_a, c.body_b) < (id_a, id_b));
-    for c in previous[start..]
-        .iter()
-        .take_while(|c| (c.body_a, c.body_b) == (id_a, id_b))
-    {
+    for c in previous.pair(id_a, id_b) {
         out.push(Contact {
             index_a: a as u32,
             index_b: b as u32,
@@ -223,11 +260,11 @@ fn keep_previous(
 /// whose features were renamed (a pair routine may pick the other box's face as reference
 /// from one step to the next), by proximity — the old point within `MATCH_DISTANCE` of it.
 /// Losing warm starts on a resting stack would restart its solution from zero each time.
-fn warm_start(contact: &mut Contact, previous: &[Contact]) {
-    let Ok(i) = previous.binary_search_by_key(&contact.key(), Contact::key) else {
+fn warm_start(contact: &mut Contact, previous: &Sorted<'_>) {
+    let Some(old) = previous.find(contact.key()).map(|c| c.manifold) else {
         return;
     };
-    let old = &previous[i].manifold;
+    let old = &old;
     let mid = |a: Vec3, b: Vec3| (a + b) * 0.5;
     for p in contact.manifold.points_mut() {
         let here = mid(p.point_a, p.point_b);

@@ -17,14 +17,6 @@ pub(crate) struct BodyState {
     pub dr: Mat3,
 }
 
-impl BodyState {
-    /// Displacement of the material point that was at offset `r` when the step began.
-    #[inline]
-    pub fn point_displacement(&self, r: Vec3) -> Vec3 {
-        self.dp + self.dr * r - r
-    }
-}
-
 /// The rest of a body's solver data.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct BodySim {

@@ -115,6 +115,9 @@ struct Point {
     rb: Vec3,
     /// Separation at the start of the step.
     separation: Real,
+    /// n · (r_b − r_a): with the bodies' motion since the step began it gives the current
+    /// separation without rotating the anchors (see `solve`).
+    lever: Real,
     normal: Row,
     tangent: [Row; 2],
     normal_impulse: Real,
@@ -228,6 +231,7 @@ impl ContactConstraint {
                 ra,
                 rb,
                 separation: mp.separation,
+                lever: normal.dot(rb - ra),
                 normal: normal_row,
                 tangent: [
                     Row::new(tangents[0], ra, rb, sa, sb),
@@ -289,8 +293,17 @@ impl ContactConstraint {
         // opposite order, so the bias of one pass cancels that of the other.
         let count = self.count;
         let order = move |k: usize| if bias { k } else { count - 1 - k };
+        // Current separation of a point: s₀ + n·(Δp_b + ΔR_b r_b − r_b − Δp_a − ΔR_a r_a + r_a)
+        // = s₀ + n·(Δp_b − Δp_a) + (ΔR_bᵀn)·r_b − (ΔR_aᵀn)·r_a − n·(r_b − r_a); the first
+        // three factors are shared by the manifold's points.
+        let n = self.normal;
+        let moved = (
+            n.dot(b.dp - a.dp),
+            a.dr.transpose() * n,
+            b.dr.transpose() * n,
+        );
         for k in 0..count {
-            self.solve_normal(order(k), a, b, rule, bias);
+            self.solve_normal(order(k), a, b, rule, bias, moved);
         }
         for k in 0..count {
             self.solve_friction(order(k), a, b, rule);
@@ -304,10 +317,11 @@ impl ContactConstraint {
         b: &mut BodyState,
         rule: &BiasRule,
         bias: bool,
+        moved: (Real, Vec3, Vec3),
     ) {
         let n = self.normal;
         let p = &mut self.points[i];
-        let s = p.separation + n.dot(b.point_displacement(p.rb) - a.point_displacement(p.ra));
+        let s = p.separation + moved.0 + moved.2.dot(p.rb) - moved.1.dot(p.ra) - p.lever;
         let (velocity_bias, mass_scale, impulse_scale) = if s > 0.0 {
             (s * rule.inv_h, 1.0, 0.0)
         } else if bias {
@@ -393,11 +407,6 @@ impl ContactConstraint {
             p.total_tangent[0] += p.tangent_impulse[0];
             p.total_tangent[1] += p.tangent_impulse[1];
         }
-    }
-
-    /// The two bodies' dense indices.
-    pub fn body_pair(&self) -> (usize, usize) {
-        (self.a, self.b)
     }
 
     /// Writes the impulses into the contact for next step's warm start and for reports.

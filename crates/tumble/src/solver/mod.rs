@@ -183,11 +183,9 @@ impl Solver {
 
     fn prepare(&mut self, bodies: &[Body], contacts: &[Contact], rule: &BiasRule) {
         self.constraints.clear();
-        for (i, c) in contacts.iter().enumerate() {
+        for i in self.colour_order(contacts) {
+            let c = &contacts[i];
             let (a, b) = (c.index_a as usize, c.index_b as usize);
-            if c.manifold.is_empty() || !(self.sims[a].moves || self.sims[b].moves) {
-                continue;
-            }
             let friction = (bodies[a].friction * bodies[b].friction).sqrt();
             let restitution = bodies[a].restitution.max(bodies[b].restitution);
             self.constraints.push(ContactConstraint::prepare(
@@ -200,32 +198,31 @@ impl Solver {
                 (friction, restitution),
             ));
         }
-        self.order_by_colour();
     }
 
-    /// Orders the constraints so that neighbours in the list rarely share a moving body
-    /// (greedy graph colouring, colour by colour). Gauss–Seidel passes are a chain of
+    /// The contacts to solve, ordered so that neighbours in the list rarely share a moving
+    /// body (greedy graph colouring, colour by colour). Gauss–Seidel passes are a chain of
     /// dependent updates; constraints on disjoint bodies let the processor overlap them.
-    /// Deterministic: colours depend only on the constraint order, itself deterministic.
-    fn order_by_colour(&mut self) {
+    /// Deterministic: colours depend only on the contacts' order, itself deterministic.
+    fn colour_order(&self, contacts: &[Contact]) -> Vec<usize> {
         let mut used = vec![0u64; self.sims.len()];
-        let mut colours = Vec::with_capacity(self.constraints.len());
-        for c in &self.constraints {
-            let (a, b) = c.body_pair();
-            let mask = |i: usize| if self.sims[i].moves { used[i] } else { 0 };
+        let mut coloured = Vec::with_capacity(contacts.len());
+        for (i, c) in contacts.iter().enumerate() {
+            let (a, b) = (c.index_a as usize, c.index_b as usize);
+            if c.manifold.is_empty() || !(self.sims[a].moves || self.sims[b].moves) {
+                continue;
+            }
+            let mask = |k: usize| if self.sims[k].moves { used[k] } else { 0 };
             let colour = (!(mask(a) | mask(b))).trailing_zeros().min(63);
-            for i in [a, b] {
-                if self.sims[i].moves {
-                    used[i] |= 1u64 << colour;
+            for k in [a, b] {
+                if self.sims[k].moves {
+                    used[k] |= 1u64 << colour;
                 }
             }
-            colours.push(colour);
+            coloured.push((colour, i));
         }
-        let mut order: Vec<usize> = (0..self.constraints.len()).collect();
-        order.sort_by_key(|&i| colours[i]);
-        let sorted: Vec<ContactConstraint> =
-            order.iter().map(|&i| self.constraints[i].clone()).collect();
-        self.constraints = sorted;
+        coloured.sort_unstable();
+        coloured.into_iter().map(|(_, i)| i).collect()
     }
 
     /// v += h F/m, L += h N for the solved bodies, forces taken at the current substep.
