@@ -192,14 +192,7 @@ fn local_region(a: &Shape, sa: &Sweep, at: &Pose) -> crate::geometry::Aabb {
         .aabb(&sa.start)
         .union(&a.aabb(&end))
         .expanded(a.bounding_radius());
-    let corners = (0..8).map(|i| {
-        at.inverse_transform_point(Vec3::new(
-            if i & 1 == 0 { world.min.x } else { world.max.x },
-            if i & 2 == 0 { world.min.y } else { world.max.y },
-            if i & 4 == 0 { world.min.z } else { world.max.z },
-        ))
-    });
-    crate::geometry::Aabb::from_points(corners).unwrap_or(world)
+    world.mapped(|c| at.inverse_transform_point(c))
 }
 
 /// Conservative advancement against a half-space n·(x − origin) ≤ offset: the gap of the

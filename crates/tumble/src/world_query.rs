@@ -217,15 +217,7 @@ fn cast_against(
 
 /// A world box seen in a body's frame (the box around its eight corners).
 fn local_box(world: &Aabb, at: &Pose) -> Aabb {
-    let corners = (0..8).map(|i| {
-        let c = Vec3::new(
-            if i & 1 == 0 { world.min.x } else { world.max.x },
-            if i & 2 == 0 { world.min.y } else { world.max.y },
-            if i & 4 == 0 { world.min.z } else { world.max.z },
-        );
-        at.inverse_transform_point(c)
-    });
-    Aabb::from_points(corners).unwrap_or(*world)
+    world.mapped(|c| at.inverse_transform_point(c))
 }
 
 /// A convex moving along `translation` against the half-space n·(x − origin) ≤ offset:

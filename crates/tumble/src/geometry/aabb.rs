@@ -71,6 +71,25 @@ impl Aabb {
         self.min.cmple(p).all() && self.max.cmpge(p).all()
     }
 
+    /// The eight corners.
+    pub fn corners(&self) -> [Vec3; 8] {
+        std::array::from_fn(|i| {
+            Vec3::new(
+                if i & 1 == 0 { self.min.x } else { self.max.x },
+                if i & 2 == 0 { self.min.y } else { self.max.y },
+                if i & 4 == 0 { self.min.z } else { self.max.z },
+            )
+        })
+    }
+
+    /// The box around this box's corners after `map` (a rigid transform of them, say).
+    pub fn mapped(&self, map: impl Fn(Vec3) -> Vec3) -> Aabb {
+        let c = self.corners().map(map);
+        c[1..].iter().fold(Aabb::new(c[0], c[0]), |b, p| {
+            Aabb::new(b.min.min(*p), b.max.max(*p))
+        })
+    }
+
     /// Centre.
     pub fn center(&self) -> Vec3 {
         (self.min + self.max) * 0.5

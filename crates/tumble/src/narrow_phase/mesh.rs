@@ -137,15 +137,7 @@ pub fn convex_heightfield(
 /// eight corners there).
 fn query_box(a: &Convex, pa: &Pose, pb: &Pose, margin: Real) -> Option<Aabb> {
     let world = convex_aabb(a, pa).expanded(margin.max(0.0));
-    let corners = (0..8).map(|i| {
-        let c = Vec3::new(
-            if i & 1 == 0 { world.min.x } else { world.max.x },
-            if i & 2 == 0 { world.min.y } else { world.max.y },
-            if i & 4 == 0 { world.min.z } else { world.max.z },
-        );
-        pb.inverse_transform_point(c)
-    });
-    let local = Aabb::from_points(corners)?;
+    let local = world.mapped(|c| pb.inverse_transform_point(c));
     let finite = |v: Vec3| v.x.is_finite() && v.y.is_finite() && v.z.is_finite();
     (finite(local.min) && finite(local.max)).then_some(local)
 }

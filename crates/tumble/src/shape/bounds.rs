@@ -47,18 +47,7 @@ impl Shape {
                 Aabb::from_points(mesh.vertices().iter().map(|v| pose.transform_point(*v)))
                     .unwrap_or(Aabb::from_center(pose.position, Vec3::ZERO))
             }
-            Shape::HeightField(field) => {
-                let b = field.local_aabb();
-                let corners = (0..8).map(|i| {
-                    Vec3::new(
-                        if i & 1 == 0 { b.min.x } else { b.max.x },
-                        if i & 2 == 0 { b.min.y } else { b.max.y },
-                        if i & 4 == 0 { b.min.z } else { b.max.z },
-                    )
-                });
-                Aabb::from_points(corners.map(|c| pose.transform_point(c)))
-                    .unwrap_or(Aabb::from_center(pose.position, Vec3::ZERO))
-            }
+            Shape::HeightField(field) => field.local_aabb().mapped(|c| pose.transform_point(c)),
         }
     }
 }
