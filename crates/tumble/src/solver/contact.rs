@@ -353,6 +353,11 @@ impl ContactConstraint {
 
     fn solve_friction(&mut self, i: usize, a: &mut BodyState, b: &mut BodyState, rule: &BiasRule) {
         let p = &mut self.points[i];
+        if p.normal_impulse == 0.0 && p.tangent_impulse == [0.0; 2] {
+            // A point that pushes nothing has a zero friction cone: nothing to do. Most
+            // speculative points (neighbours side by side in a pile) are such.
+            return;
+        }
         let vt = [
             p.tangent[0].velocity(self.tangents[0], a, b),
             p.tangent[1].velocity(self.tangents[1], a, b),
