@@ -148,6 +148,9 @@ pub struct Body {
     pub(crate) principal_axes: Mat3,
     /// The same axes as a rotation from the principal frame to the body frame.
     pub(crate) principal_rotation: Quat,
+    /// All principal moments equal (spheres, cubes): the inertia tensor is a multiple
+    /// of the identity in every frame.
+    pub(crate) isotropic: bool,
     /// For planar bodies, I_zz of the world tensor, constant under rotations about z.
     pub(crate) planar_inertia: Real,
     // State.
@@ -198,6 +201,8 @@ impl Body {
             principal_moments: moments,
             principal_axes: axes,
             principal_rotation: Quat::from_mat3(&axes).normalize(),
+            isotropic: moments.max_element() - moments.min_element()
+                <= 1e-12 * moments.max_element(),
             planar_inertia: 0.0,
             com: def.position + orientation * props.center,
             orientation,

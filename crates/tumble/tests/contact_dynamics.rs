@@ -232,10 +232,11 @@ fn drift(w: &mut World, ids: &[BodyId], seconds: Real) -> Real {
 
 #[test]
 fn a_stack_of_twenty_boxes_stands_with_and_without_sleeping() {
-    // A 20-box tower on soft contacts is near its buckling load (see docs/integrators.md);
-    // in f32 the rounding tips it over with one iteration per substep (13 cm of drift
-    // measured), so that build uses two.
-    let iterations = if single_precision() { 2 } else { 1 };
+    // A 20-box tower on soft contacts is near its buckling load (see docs/integrators.md).
+    // In f32 the rounding noise keeps it swaying: measured drift 3.0 / 2.2 / 1.2 / 0.7 cm
+    // with 1 / 2 / 3 / 4 iterations per substep, against 2.2 mm with 1 in f64. The f32
+    // build therefore uses 4, and this is a known weakness of single precision here.
+    let iterations = if single_precision() { 4 } else { 1 };
     for sleep in [false, true] {
         let mut w = scene(sleep, 4);
         let mut settings = w.solver_settings();

@@ -23,6 +23,9 @@ pub(crate) fn drift(body: &Body, q: Quat, l: Vec3, w: Vec3, h: Real) -> Quat {
             // The seed's 2D rule: θ₊ = θ + h L_z / I_zz about world z.
             exact_spin(Vec3::new(0.0, 0.0, l.z / body.planar_inertia), q, h)
         }
+        // A ball-like body (all principal moments equal) keeps ω = L/I constant while
+        // torque-free: one exact rotation, where the splitting would take five.
+        BodyKind::Dynamic if body.isotropic => exact_spin(l / body.principal_moments.x, q, h),
         BodyKind::Dynamic => free_rotor(body, q, l, h),
     }
 }
