@@ -4,6 +4,7 @@
 
 use crate::body::{Body, BodyKind};
 use crate::broad_phase::BroadPhase;
+use crate::geometry::Pose;
 use crate::id::BodyId;
 use crate::math::{Real, Vec3};
 use crate::narrow_phase::{collide, Manifold};
@@ -126,7 +127,7 @@ impl ContactCache {
                     index_a: a as u32,
                     index_b: b as u32,
                 };
-                warm_start(&mut contact, &old);
+                warm_start(&mut contact, &old, (&body_a.pose(), &body_b.pose()));
                 self.contacts.push(contact);
             }
         }
@@ -260,8 +261,19 @@ fn keep_previous(
 /// whose features were renamed (a pair routine may pick the other box's face as reference
 /// from one step to the next), by proximity — the old point within `MATCH_DISTANCE` of it.
 /// Losing warm starts on a resting stack would restart its solution from zero each time.
-fn warm_start(contact: &mut Contact, previous: &Sorted<'_>) {
+fn warm_start(contact: &mut Contact, previous: &Sorted<'_>, poses: (&Pose, &Pose)) {
+    let anchor_here = |p: &mut crate::narrow_phase::ContactPoint| {
+        let mid = (p.point_a + p.point_b) * 0.5;
+        p.anchor_a = poses.0.inverse_transform_point(mid);
+        p.anchor_b = poses.1.inverse_transform_point(mid);
+        p.anchored = true;
+    };
     let Some(old) = previous.find(contact.key()).map(|c| c.manifold) else {
+        contact
+            .manifold
+            .points_mut()
+            .iter_mut()
+            .for_each(anchor_here);
         return;
     };
     let old = &old;
@@ -277,9 +289,17 @@ fn warm_start(contact: &mut Contact, previous: &Sorted<'_>) {
                 .min_by(|x, y| x.1.total_cmp(&y.1))
                 .map(|(q, _)| q)
         };
-        if let Some(q) = by_feature.or_else(by_place) {
-            p.normal_impulse = q.normal_impulse;
-            p.tangent_impulse = q.tangent_impulse;
+        match by_feature.or_else(by_place) {
+            Some(q) => {
+                p.normal_impulse = q.normal_impulse;
+                p.tangent_impulse = q.tangent_impulse;
+                if q.anchored && !q.sliding {
+                    (p.anchor_a, p.anchor_b, p.anchored) = (q.anchor_a, q.anchor_b, true);
+                } else {
+                    anchor_here(p);
+                }
+            }
+            None => anchor_here(p),
         }
     }
 }

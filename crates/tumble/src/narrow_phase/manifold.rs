@@ -41,6 +41,16 @@ pub struct ContactPoint {
     pub total_normal_impulse: Real,
     /// Friction impulse applied over the whole last step, world frame (N·s).
     pub total_tangent_impulse: Vec3,
+    /// Where the contact first held, as a point of each body's frame (friction anchors):
+    /// while the contact sticks, the solver pulls these two back together, so a resting
+    /// body does not creep.
+    pub anchor_a: Vec3,
+    /// The anchor in body B's frame.
+    pub anchor_b: Vec3,
+    /// Whether the anchors hold (false for a new point, or one that slid last step).
+    pub anchored: bool,
+    /// Whether friction reached its cone at this point last step.
+    pub sliding: bool,
 }
 
 /// Most points a manifold holds: four span any flat contact patch stably.

@@ -23,7 +23,7 @@ mod softness;
 pub use softness::Softness;
 
 use body::{BodySim, BodyState};
-use contact::{BiasRule, ContactConstraint};
+use contact::{BiasRule, ContactConstraint, PairData};
 
 use crate::body::{Body, BodyKind};
 use crate::contact_cache::Contact;
@@ -188,14 +188,22 @@ impl Solver {
             let (a, b) = (c.index_a as usize, c.index_b as usize);
             let friction = (bodies[a].friction * bodies[b].friction).sqrt();
             let restitution = bodies[a].restitution.max(bodies[b].restitution);
+            let pose = |k: usize| {
+                let s = &self.sims[k];
+                crate::geometry::Pose::new(s.x - s.q * bodies[k].local_center, s.q)
+            };
+            let pair = PairData {
+                bodies: (a, b),
+                material: (friction, restitution),
+                poses: (pose(a), pose(b)),
+            };
             self.constraints.push(ContactConstraint::prepare(
                 i,
                 c,
-                (a, b),
+                &pair,
                 &self.sims,
                 &self.states,
                 rule,
-                (friction, restitution),
             ));
         }
     }
