@@ -525,15 +525,26 @@ impl World {
             lookup: &find,
             callbacks: &mut self.callbacks,
         };
-        integrate::advance(
-            self.integrator,
-            &mut system,
-            &mut motions,
-            &mut self.verlet,
-            self.time,
-            dt,
-            &mut self.scratch,
-        );
+        // When every awake dynamic body is in contact, the integrator's whole-step result
+        // would be thrown away for all of them; only kinematic bodies need moving.
+        let free = self
+            .bodies
+            .iter()
+            .zip(&self.solved)
+            .any(|(b, s)| b.kind == BodyKind::Dynamic && b.awake && !s);
+        if free {
+            integrate::advance(
+                self.integrator,
+                &mut system,
+                &mut motions,
+                &mut self.verlet,
+                self.time,
+                dt,
+                &mut self.scratch,
+            );
+        } else {
+            integrate::move_kinematic(self.bodies.as_slice(), &mut motions, dt);
+        }
         for ((m, start), body) in motions.iter_mut().zip(&self.start).zip(&self.bodies) {
             if !body.awake {
                 *m = *start;

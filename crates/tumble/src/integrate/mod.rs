@@ -256,14 +256,19 @@ pub(crate) fn advance(
     }
     // Prescribed motion is known exactly; no method should add its own error to it.
     for ((m, start), body) in motions.iter_mut().zip(&scratch.start).zip(sys.bodies) {
-        match body.kind {
-            BodyKind::Static => *m = *start,
-            BodyKind::Kinematic => {
-                *m = *start;
-                m.x += start.v * h;
-                m.q = rotation::exact_spin(start.w, start.q, h);
-            }
-            BodyKind::Dynamic => {}
+        if body.kind != BodyKind::Dynamic {
+            *m = *start;
+        }
+    }
+    move_kinematic(sys.bodies, motions, h);
+}
+
+/// Moves kinematic bodies exactly along their prescribed velocities: x + h v, exp(hω/2) q.
+pub(crate) fn move_kinematic(bodies: &[Body], motions: &mut [Motion], h: Real) {
+    for (m, body) in motions.iter_mut().zip(bodies) {
+        if body.kind == BodyKind::Kinematic {
+            m.x += m.v * h;
+            m.q = rotation::exact_spin(m.w, m.q, h);
         }
     }
 }
