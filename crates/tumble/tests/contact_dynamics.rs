@@ -469,3 +469,59 @@ fn a_sleeping_island_wakes_when_its_support_goes_or_something_hits_it() {
     run(&mut w, 1.0 / 60.0, 30);
     assert!(w.body(ids[0]).unwrap().position().y < 0.0);
 }
+
+#[test]
+fn a_box_slides_over_a_floor_of_adjoining_boxes_without_catching_on_the_seams() {
+    // Twelve unit boxes side by side make the floor; a 0.5 m box slides across six seams.
+    // Either creation order (the floor's boxes as body A or as body B of the pairs).
+    for floor_first in [true, false] {
+        for mu in [0.0, 0.3] {
+            let mut w = scene(false, 4);
+            let floor = |w: &mut World| {
+                for i in 0..12 {
+                    let def = BodyDef {
+                        kind: BodyKind::Static,
+                        position: Vec3::new(i as Real - 5.5, -0.5, 0.0),
+                        friction: mu,
+                        ..Default::default()
+                    };
+                    w.create_body(&def, Shape::cuboid(Vec3::splat(0.5)))
+                        .unwrap();
+                }
+            };
+            if floor_first {
+                floor(&mut w);
+            }
+            let def = BodyDef {
+                position: Vec3::new(-5.0, 0.25, 0.0),
+                linear_velocity: Vec3::new(4.0, 0.0, 0.0),
+                friction: mu,
+                ..Default::default()
+            };
+            let b = dynamic(&mut w, def, Shape::cuboid(Vec3::splat(0.25)));
+            if !floor_first {
+                floor(&mut w);
+            }
+            let mut worst_vy: Real = 0.0;
+            for _ in 0..120 {
+                w.step(1.0 / 60.0).unwrap();
+                worst_vy = worst_vy.max(w.body(b).unwrap().linear_velocity().y.abs());
+            }
+            assert!(
+                worst_vy < 1e-2,
+                "floor first {floor_first}, μ {mu}: hopped at {worst_vy} m/s"
+            );
+            let x = w.body(b).unwrap().position().x;
+            // Frictionless: 4 m/s for 2 s; with friction: v²/(2μg) of sliding, as on one box.
+            let expect = if mu == 0.0 {
+                3.0
+            } else {
+                -5.0 + 16.0 / (2.0 * mu * G)
+            };
+            assert!(
+                (x - expect).abs() < 0.02 * (expect + 5.0),
+                "floor first {floor_first}, μ {mu}: ended at {x}, expected {expect}"
+            );
+        }
+    }
+}
