@@ -23,35 +23,22 @@ use crate::narrow_phase::MAX_MANIFOLD_POINTS;
 /// How position error turns into velocity in one substep.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct BiasRule {
-    /// The substep (s) and its inverse: a speculative gap s may close at s/h.
-    pub h: Real,
+    /// 1 / substep (1/s): a speculative gap s may close at s/h.
     pub inv_h: Real,
-    /// Soft step: the contact spring (Hz, damping ratio). `None`: PGS with Baumgarte.
-    pub spring: Option<(Real, Real)>,
-    /// PGS: the rigid row with Baumgarte's bias rate β/h.
-    pub baumgarte: Softness,
+    /// Every contact's position correction: the soft-step spring, or for PGS the rigid
+    /// row with Baumgarte's bias rate β/h.
+    ///
+    /// Unlike Box2D v3 (2D), contacts with immovable bodies are not made twice as stiff:
+    /// in 3D a light box pressed between the ground and a heavy body then rings (measured:
+    /// 0.1 m/s of jitter at 10:1), while the default spring of a quarter of the substep
+    /// rate already holds a 20-box tower to millimetres.
+    pub softness: Softness,
     /// Penetration tolerated without correction (m); zero for soft step.
     pub slop: Real,
     /// Fastest push-out speed (m/s).
     pub max_push: Real,
     /// Tangential speed above which a contact counts as sliding (m/s).
     pub slip_speed: Real,
-}
-
-impl BiasRule {
-    /// The softness of one contact: the soft-step spring, or PGS's Baumgarte row.
-    ///
-    /// Unlike Box2D v3 (2D), contacts with immovable bodies are not made twice as stiff:
-    /// in 3D a light box pressed between the ground and a heavy body then rings (measured:
-    /// 0.1 m/s of jitter at 10:1), while the default spring of a quarter of the substep
-    /// rate already holds a 20-box tower to millimetres.
-    fn softness(&self, a: &BodySim, b: &BodySim) -> Softness {
-        let Some((hertz, zeta)) = self.spring else {
-            return self.baumgarte;
-        };
-        let _ = (a, b);
-        Softness::new(hertz, zeta, self.h)
-    }
 }
 
 /// One Jacobian row at one point: angular parts and their images under I⁻¹.
@@ -161,7 +148,6 @@ pub(crate) struct ContactConstraint {
     push_b: [Vec3; 3],
     /// Whether the solver moves body a, body b.
     moves: (bool, bool),
-    softness: Softness,
     friction: Real,
     restitution: Real,
     points: [Point; MAX_MANIFOLD_POINTS],
@@ -221,7 +207,6 @@ impl ContactConstraint {
         pair: &PairData,
         sims: &[BodySim],
         states: &[BodyState],
-        rule: &BiasRule,
     ) -> Self {
         let (a, b) = pair.bodies;
         let (friction, restitution) = pair.material;
@@ -240,7 +225,6 @@ impl ContactConstraint {
             push_a: dirs.map(|d| sa.linear_mask * d * sa.inv_mass),
             push_b: dirs.map(|d| sb.linear_mask * d * sb.inv_mass),
             moves: (sa.moves, sb.moves),
-            softness: rule.softness(sa, sb),
             friction,
             restitution,
             points: [Point::default(); MAX_MANIFOLD_POINTS],
@@ -367,7 +351,7 @@ impl ContactConstraint {
         let (velocity_bias, mass_scale, impulse_scale) = if s > 0.0 {
             (s * rule.inv_h, 1.0, 0.0)
         } else if bias {
-            let soft = &self.softness;
+            let soft = &rule.softness;
             let error = (s + rule.slop).min(0.0);
             (
                 (soft.bias_rate * error).max(-rule.max_push),
@@ -405,7 +389,7 @@ impl ContactConstraint {
         rule: &BiasRule,
         slip: Option<[(Real, Vec3, Vec3); 2]>,
     ) {
-        let soft = self.softness;
+        let soft = rule.softness;
         let p = &mut self.points[i];
         if p.normal_impulse == 0.0 && p.tangent_impulse == [0.0; 2] {
             // A point that pushes nothing has a zero friction cone: nothing to do. Most

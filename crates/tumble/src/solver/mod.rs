@@ -136,7 +136,7 @@ impl Solver {
             self.states.push(state);
         }
         let rule = bias_rule(input.settings, input.scales, h);
-        self.prepare(bodies, contacts, &rule);
+        self.prepare(bodies, contacts);
         for i in 0..substeps {
             self.kick(input.system, input.time + i as Real * h, h);
             for c in &self.constraints {
@@ -181,7 +181,7 @@ impl Solver {
         }
     }
 
-    fn prepare(&mut self, bodies: &[Body], contacts: &[Contact], rule: &BiasRule) {
+    fn prepare(&mut self, bodies: &[Body], contacts: &[Contact]) {
         self.constraints.clear();
         for i in self.colour_order(contacts) {
             let c = &contacts[i];
@@ -203,7 +203,6 @@ impl Solver {
                 &pair,
                 &self.sims,
                 &self.states,
-                rule,
             ));
         }
     }
@@ -292,18 +291,18 @@ impl Solver {
 fn bias_rule(settings: &SolverSettings, scales: &Scales, h: Real) -> BiasRule {
     let inv_h = 1.0 / h;
     BiasRule {
-        h,
         inv_h,
-        spring: (settings.kind == SolverKind::SoftStep).then(|| {
-            (
+        softness: match settings.kind {
+            SolverKind::SoftStep => Softness::new(
                 settings.contact_hertz.min(0.25 * inv_h),
                 settings.contact_damping_ratio,
-            )
-        }),
-        baumgarte: Softness {
-            bias_rate: settings.baumgarte * inv_h,
-            mass_scale: 1.0,
-            impulse_scale: 0.0,
+                h,
+            ),
+            SolverKind::Pgs => Softness {
+                bias_rate: settings.baumgarte * inv_h,
+                mass_scale: 1.0,
+                impulse_scale: 0.0,
+            },
         },
         slop: if settings.kind == SolverKind::Pgs {
             scales.linear_slop
