@@ -10,7 +10,7 @@
 //!     solve     (iterations passes, with position bias: soft spring or Baumgarte)
 //!     drift     x += h v, q by the rotor splitting with L (exact torque-free turning)
 //!     relax     (soft step only: passes without bias, removing the push-out velocity)
-//! restitution, then store impulses for the next step's warm start
+//! bounces (restitution.rs), then store impulses for the next step's warm start
 //! ```
 //!
 //! This is Box2D v3's soft step (Catto 2024) carried to 3D, with angular momentum as the
@@ -18,6 +18,7 @@
 
 mod body;
 mod contact;
+mod restitution;
 mod softness;
 
 pub use softness::Softness;
@@ -111,6 +112,9 @@ pub(crate) struct StepInput<'a, 'b> {
 pub(crate) struct Solver {
     sims: Vec<BodySim>,
     states: Vec<BodyState>,
+    /// The states at the step's start, for the bounce replay.
+    start_states: Vec<BodyState>,
+    moving: Vec<bool>,
     constraints: Vec<ContactConstraint>,
     wrench: Vec<Wrench>,
     motions: Vec<Motion>,
@@ -135,6 +139,7 @@ impl Solver {
             self.sims.push(sim);
             self.states.push(state);
         }
+        self.start_states.clone_from(&self.states);
         let rule = bias_rule(input.settings, input.scales, h);
         self.prepare(bodies, contacts);
         for i in 0..substeps {
@@ -159,8 +164,16 @@ impl Solver {
                 c.add_to_totals();
             }
         }
-        for c in &mut self.constraints {
-            c.restitution(&mut self.states, input.scales.restitution_threshold);
+        self.moving.clear();
+        self.moving.extend(self.sims.iter().map(|s| s.moves));
+        restitution::resolve_bounces(
+            &mut self.constraints,
+            &mut self.states,
+            &self.start_states,
+            &self.moving,
+            input.scales.restitution_threshold,
+        );
+        for c in &self.constraints {
             c.store_impulses(&mut contacts[c.contact]);
         }
         for ((m, sim), (state, body)) in motions
