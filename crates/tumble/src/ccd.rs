@@ -104,7 +104,16 @@ pub(crate) fn sweep_fast_bodies(
 }
 
 /// Earliest impact parameter of a moving shape against a resting one, or `limit`.
-fn shape_toi(a: &Shape, sa: &Sweep, b: &Shape, sb: &Sweep, slop: Real, limit: Real) -> Real {
+/// Convex shapes and compounds may both move; a mesh, height field or plane must be `b`
+/// and at rest.
+pub(crate) fn shape_toi(
+    a: &Shape,
+    sa: &Sweep,
+    b: &Shape,
+    sb: &Sweep,
+    slop: Real,
+    limit: Real,
+) -> Real {
     let child_sweep = |s: &Sweep, position: Vec3, orientation: Quat| {
         let child = s.start.mul(&Pose::new(position, orientation));
         Sweep {

@@ -31,6 +31,7 @@ pub mod narrow_phase;
 pub mod query;
 pub mod shape;
 pub mod solver;
+pub(crate) mod speculative;
 pub mod world;
 pub mod world_query;
 

@@ -101,6 +101,8 @@ pub struct World {
     solver: Solver,
     start: Vec<Motion>,
     solved: Vec<bool>,
+    /// Contacts the solver leaves out this step (see `speculative.rs`).
+    ghosts: Vec<bool>,
     sleep_enabled: bool,
     sleep_tag: u32,
     pub(crate) broad_phase: BroadPhase,
@@ -151,6 +153,7 @@ impl World {
             solver: Solver::default(),
             start: Vec::new(),
             solved: Vec::new(),
+            ghosts: Vec::new(),
             sleep_enabled: def.sleep,
             sleep_tag: 0,
             broad_phase: BroadPhase::new(Tolerances::new(def.length_unit).aabb_margin),
@@ -516,6 +519,14 @@ impl World {
         self.start.clear();
         self.start.extend_from_slice(&motions);
         self.mark_solved();
+        crate::speculative::find_ghosts(
+            &self.bodies,
+            self.contacts.contacts(),
+            self.gravity,
+            dt * (1.0 + 1.0 / self.solver_settings.substeps.max(1) as Real),
+            self.tolerances.scales.linear_slop,
+            &mut self.ghosts,
+        );
         let slots = &self.slots;
         let find = |id: BodyId| lookup(slots, id);
         let mut system = System {
@@ -566,6 +577,7 @@ impl World {
                 settings: &self.solver_settings,
                 scales: &self.tolerances.scales,
                 solved: &self.solved,
+                ghosts: &self.ghosts,
                 time: self.time,
                 dt,
             };

@@ -103,6 +103,8 @@ pub(crate) struct StepInput<'a, 'b> {
     pub scales: &'a Scales,
     /// Which bodies the solver advances (dynamic bodies touching something).
     pub solved: &'a [bool],
+    /// Contacts to leave out this step (speculative ones the bodies will not reach).
+    pub ghosts: &'a [bool],
     pub time: Real,
     pub dt: Real,
 }
@@ -141,7 +143,7 @@ impl Solver {
         }
         self.start_states.clone_from(&self.states);
         let rule = bias_rule(input.settings, input.scales, h);
-        self.prepare(bodies, contacts);
+        self.prepare(bodies, contacts, input.ghosts);
         for i in 0..substeps {
             self.kick(input.system, input.time + i as Real * h, h);
             for c in &self.constraints {
@@ -194,9 +196,9 @@ impl Solver {
         }
     }
 
-    fn prepare(&mut self, bodies: &[Body], contacts: &[Contact]) {
+    fn prepare(&mut self, bodies: &[Body], contacts: &[Contact], ghosts: &[bool]) {
         self.constraints.clear();
-        for i in self.colour_order(contacts) {
+        for i in self.colour_order(contacts, ghosts) {
             let c = &contacts[i];
             let (a, b) = (c.index_a as usize, c.index_b as usize);
             let friction = (bodies[a].friction * bodies[b].friction).sqrt();
@@ -224,12 +226,13 @@ impl Solver {
     /// body (greedy graph colouring, colour by colour). Gauss–Seidel passes are a chain of
     /// dependent updates; constraints on disjoint bodies let the processor overlap them.
     /// Deterministic: colours depend only on the contacts' order, itself deterministic.
-    fn colour_order(&self, contacts: &[Contact]) -> Vec<usize> {
+    fn colour_order(&self, contacts: &[Contact], ghosts: &[bool]) -> Vec<usize> {
         let mut used = vec![0u64; self.sims.len()];
         let mut coloured = Vec::with_capacity(contacts.len());
         for (i, c) in contacts.iter().enumerate() {
             let (a, b) = (c.index_a as usize, c.index_b as usize);
-            if c.manifold.is_empty() || !(self.sims[a].moves || self.sims[b].moves) {
+            let idle = c.manifold.is_empty() || ghosts.get(i).copied().unwrap_or(false);
+            if idle || !(self.sims[a].moves || self.sims[b].moves) {
                 continue;
             }
             let mask = |k: usize| if self.sims[k].moves { used[k] } else { 0 };
