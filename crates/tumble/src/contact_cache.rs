@@ -82,6 +82,7 @@ impl ContactCache {
         bodies: &[Body],
         ids: &[BodyId],
         margin: Real,
+        joined: &[(u32, u32)],
     ) {
         broad.pairs(&mut self.pairs);
         let statics = bodies.iter().filter(|b| b.kind == BodyKind::Static).count();
@@ -101,6 +102,11 @@ impl ContactCache {
                 continue;
             };
             if body_a.kind != BodyKind::Dynamic && body_b.kind != BodyKind::Dynamic {
+                continue;
+            }
+            // Bodies a joint holds together do not collide unless it says so.
+            let key = (a.min(b) as u32, a.max(b) as u32);
+            if !joined.is_empty() && joined.binary_search(&key).is_ok() {
                 continue;
             }
             // A sleeping island costs nothing: between bodies that cannot have moved, last

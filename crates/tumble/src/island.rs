@@ -1,6 +1,6 @@
 //! Islands and sleeping.
 //!
-//! Dynamic bodies joined by contacts form islands (static and kinematic bodies do not join
+//! Dynamic bodies joined by contacts or joints form islands (static and kinematic bodies do not join
 //! them: they are shared by everything resting on them). An island whose every body has
 //! been slower than the thresholds for `TIME_TO_SLEEP` falls asleep as a whole: its bodies
 //! stop, are skipped by the integrator, the solver and the narrow phase, and keep their
@@ -46,13 +46,32 @@ pub(crate) fn wake_island(bodies: &mut [Body], index: usize) {
     }
 }
 
-/// Wakes sleeping islands that an active body touches, until nothing changes (an island
-/// woken this way may itself touch another sleeping one).
-pub(crate) fn wake_touched(bodies: &mut [Body], contacts: &[Contact]) {
+/// The pairs of dense body indices that contacts with points and joints connect.
+fn links<'a>(
+    contacts: &'a [Contact],
+    joints: &'a [[Option<usize>; 2]],
+) -> impl Iterator<Item = (usize, usize)> + 'a {
+    let touching = contacts
+        .iter()
+        .filter(|c| !c.manifold.is_empty())
+        .map(|c| (c.index_a as usize, c.index_b as usize));
+    let joined = joints.iter().filter_map(|j| match *j {
+        [Some(a), Some(b)] => Some((a, b)),
+        _ => None,
+    });
+    touching.chain(joined)
+}
+
+/// Wakes sleeping islands that an active body touches or is joined to, until nothing
+/// changes (an island woken this way may itself touch another sleeping one).
+pub(crate) fn wake_touched(
+    bodies: &mut [Body],
+    contacts: &[Contact],
+    joints: &[[Option<usize>; 2]],
+) {
     loop {
         let mut changed = false;
-        for c in contacts.iter().filter(|c| !c.manifold.is_empty()) {
-            let (a, b) = (c.index_a as usize, c.index_b as usize);
+        for (a, b) in links(contacts, joints) {
             for (x, y) in [(a, b), (b, a)] {
                 if active(&bodies[x]) && bodies[y].kind == BodyKind::Dynamic && !bodies[y].awake {
                     wake_island(bodies, y);
@@ -71,6 +90,7 @@ pub(crate) fn wake_touched(bodies: &mut [Body], contacts: &[Contact]) {
 pub(crate) fn update_sleep(
     bodies: &mut [Body],
     contacts: &[Contact],
+    joints: &[[Option<usize>; 2]],
     dt: Real,
     linear_speed: Real,
     tag: &mut u32,
@@ -84,8 +104,7 @@ pub(crate) fn update_sleep(
         b.sleep_time = if resting { b.sleep_time + dt } else { 0.0 };
     }
     let mut parent: Vec<usize> = (0..bodies.len()).collect();
-    for c in contacts.iter().filter(|c| !c.manifold.is_empty()) {
-        let (a, b) = (c.index_a as usize, c.index_b as usize);
+    for (a, b) in links(contacts, joints) {
         if bodies[a].kind == BodyKind::Dynamic && bodies[b].kind == BodyKind::Dynamic {
             union(&mut parent, a, b);
         }
@@ -100,8 +119,7 @@ pub(crate) fn update_sleep(
         let root = find(&mut parent, i);
         island_rest[root] = island_rest[root].min(b.sleep_time);
     }
-    for c in contacts.iter().filter(|c| !c.manifold.is_empty()) {
-        let (a, b) = (c.index_a as usize, c.index_b as usize);
+    for (a, b) in links(contacts, joints) {
         for (x, y) in [(a, b), (b, a)] {
             if bodies[x].kind == BodyKind::Kinematic
                 && active(&bodies[x])

@@ -26,6 +26,7 @@ pub mod geometry;
 pub mod id;
 pub mod integrate;
 pub(crate) mod island;
+pub mod joint;
 pub mod math;
 pub mod narrow_phase;
 pub mod query;
@@ -33,6 +34,7 @@ pub mod shape;
 pub mod solver;
 pub(crate) mod speculative;
 pub mod world;
+mod world_joints;
 pub mod world_query;
 
 pub use body::{Body, BodyDef, BodyKind, InertiaSpec, MassSpec};
@@ -45,6 +47,7 @@ pub use force::{
 pub use geometry::{Aabb, Convex, Pose, Ray, RayHit};
 pub use id::{BodyId, ForceId};
 pub use integrate::Integrator;
+pub use joint::{Joint, JointDef, JointId, JointKind, JointSpring, Motor};
 pub use math::{Mat3, Quat, Real, Vec3};
 pub use narrow_phase::{ContactPoint, Manifold};
 pub use shape::{CompoundChild, ConvexHull, HeightField, MassProperties, Shape, TriMesh};
@@ -56,7 +59,8 @@ pub use world_query::{QueryFilter, WorldRayHit, WorldShapeHit};
 pub mod prelude {
     pub use crate::{
         AppliedForce, Body, BodyDef, BodyId, BodyKind, CompoundChild, Diagnostics, Drag, Error,
-        Force, ForceContext, ForceId, InertiaSpec, Integrator, MassSpec, Mat3, Quat, Real, Shape,
-        SolverKind, SolverSettings, Spring, SpringEnd, Vec3, World, WorldDef,
+        Force, ForceContext, ForceId, InertiaSpec, Integrator, JointDef, JointId, JointKind,
+        JointSpring, MassSpec, Mat3, Motor, Quat, Real, Shape, SolverKind, SolverSettings, Spring,
+        SpringEnd, Vec3, World, WorldDef,
     };
 }

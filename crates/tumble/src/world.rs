@@ -8,6 +8,7 @@ use crate::error::{check, Error, Result};
 use crate::force::{Force, ForceCallback};
 use crate::id::{BodyId, ForceId};
 use crate::integrate::{self, Integrator, Motion, Scratch, System, VerletMemory};
+use crate::joint::{Joint, JointId};
 use crate::math::{Quat, Real, Vec3};
 use crate::shape::Shape;
 use crate::solver::{Scales, Solver, SolverSettings, StepInput};
@@ -85,7 +86,7 @@ pub struct World {
     time: Real,
     step_count: u64,
     // Bodies are dense, in creation order; `slots` maps ids to dense indices.
-    bodies: Vec<Body>,
+    pub(crate) bodies: Vec<Body>,
     body_ids: Vec<BodyId>,
     verlet: Vec<Option<VerletMemory>>,
     slots: Vec<Slot>,
@@ -109,6 +110,14 @@ pub struct World {
     /// One broad-phase proxy per body, in body order.
     pub(crate) proxies: Vec<ProxyId>,
     contacts: ContactCache,
+    /// Joints in creation order, with their handles (see `world_joints.rs`).
+    pub(crate) joints: Vec<Joint>,
+    pub(crate) joint_ids: Vec<JointId>,
+    pub(crate) next_joint_id: u32,
+    /// Each joint's bodies as dense indices, refreshed every step.
+    pub(crate) joint_bodies: Vec<[Option<usize>; 2]>,
+    /// Dense body pairs a joint keeps from colliding, sorted, refreshed every step.
+    pub(crate) joined_pairs: Vec<(u32, u32)>,
 }
 
 impl World {
@@ -159,6 +168,11 @@ impl World {
             broad_phase: BroadPhase::new(Tolerances::new(def.length_unit).aabb_margin),
             proxies: Vec::new(),
             contacts: ContactCache::default(),
+            joints: Vec::new(),
+            joint_ids: Vec::new(),
+            next_joint_id: 0,
+            joint_bodies: Vec::new(),
+            joined_pairs: Vec::new(),
         }
     }
 
@@ -225,6 +239,7 @@ impl World {
             self.broad_phase.set_user(*proxy, i as u32);
         }
         self.contacts.forget(id, dense);
+        self.remove_joints_of(id);
         let slot = &mut self.slots[id.index as usize];
         slot.dense = None;
         slot.generation = slot.generation.wrapping_add(1);
@@ -244,7 +259,7 @@ impl World {
         Ok(())
     }
 
-    fn dense(&self, id: BodyId) -> Option<usize> {
+    pub(crate) fn dense(&self, id: BodyId) -> Option<usize> {
         lookup(&self.slots, id)
     }
 
@@ -290,7 +305,7 @@ impl World {
 
     /// Wakes body `i`'s island and every island touching it: after an edit nothing that
     /// rests on it, or that it rests on, may assume the world is unchanged.
-    fn wake_around(&mut self, i: usize) {
+    pub(crate) fn wake_around(&mut self, i: usize) {
         crate::island::wake_island(&mut self.bodies, i);
         let touching: Vec<usize> = self
             .contacts
@@ -511,8 +526,13 @@ impl World {
     /// through the solver's substeps (see `solver/mod.rs`).
     pub fn step(&mut self, dt: Real) -> Result<()> {
         check::positive("dt", dt)?;
+        self.refresh_joint_links();
         self.update_contacts();
-        crate::island::wake_touched(&mut self.bodies, self.contacts.contacts());
+        crate::island::wake_touched(
+            &mut self.bodies,
+            self.contacts.contacts(),
+            &self.joint_bodies,
+        );
         let mut motions = std::mem::take(&mut self.motions);
         motions.clear();
         motions.extend(self.bodies.iter().map(Motion::of));
@@ -578,6 +598,8 @@ impl World {
                 scales: &self.tolerances.scales,
                 solved: &self.solved,
                 ghosts: &self.ghosts,
+                joints: &mut self.joints,
+                joint_bodies: &self.joint_bodies,
                 time: self.time,
                 dt,
             };
@@ -597,6 +619,7 @@ impl World {
             crate::island::update_sleep(
                 &mut self.bodies,
                 self.contacts.contacts(),
+                &self.joint_bodies,
                 dt,
                 self.tolerances.sleep_speed,
                 &mut self.sleep_tag,
@@ -607,18 +630,20 @@ impl World {
         Ok(())
     }
 
-    /// Marks the dynamic bodies that take part in a contact with points.
+    /// Marks the dynamic bodies that take part in a contact with points or a joint.
     fn mark_solved(&mut self) {
         self.solved.clear();
         self.solved.resize(self.bodies.len(), false);
-        for c in self.contacts.contacts() {
-            if c.manifold.is_empty() {
-                continue;
-            }
-            for i in [c.index_a as usize, c.index_b as usize] {
-                if self.bodies[i].kind == BodyKind::Dynamic && self.bodies[i].awake {
-                    self.solved[i] = true;
-                }
+        let touching = self
+            .contacts
+            .contacts()
+            .iter()
+            .filter(|c| !c.manifold.is_empty())
+            .flat_map(|c| [c.index_a as usize, c.index_b as usize]);
+        let joined = self.joint_bodies.iter().flatten().flatten().copied();
+        for i in touching.chain(joined) {
+            if self.bodies[i].kind == BodyKind::Dynamic && self.bodies[i].awake {
+                self.solved[i] = true;
             }
         }
     }
@@ -661,6 +686,8 @@ impl World {
         check::positive("contact_hertz", settings.contact_hertz)?;
         check::non_negative("contact_damping_ratio", settings.contact_damping_ratio)?;
         check::non_negative("baumgarte", settings.baumgarte)?;
+        check::positive("joint_hertz", settings.joint_hertz)?;
+        check::non_negative("joint_damping_ratio", settings.joint_damping_ratio)?;
         self.solver_settings = settings;
         Ok(())
     }
@@ -673,6 +700,7 @@ impl World {
             &self.bodies,
             &self.body_ids,
             self.tolerances.contact_margin,
+            &self.joined_pairs,
         );
         self.contacts.contacts()
     }

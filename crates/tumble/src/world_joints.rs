@@ -1,0 +1,134 @@
+//! The world's joints: creating, finding and removing them, and what the step needs of
+//! them (which bodies they join, which pairs they keep from colliding).
+
+use crate::error::{Error, Result};
+use crate::id::BodyId;
+use crate::joint::{self, Joint, JointDef, JointId};
+use crate::world::World;
+
+impl World {
+    /// Creates a joint between the bodies of `def`, measuring its angles from their poses
+    /// now. Fails, changing nothing, on bad numbers (`limits: lower must be <= upper`),
+    /// an unknown body (`other: unknown or removed body`) or a name already taken. Wakes
+    /// both bodies.
+    pub fn create_joint(&mut self, def: &JointDef) -> Result<JointId> {
+        joint::validate(def)?;
+        if let Some(name) = &def.name {
+            if self.find_joint(name).is_some() {
+                return Err(Error::invalid(
+                    "name",
+                    format!("a joint named '{name}' already exists"),
+                ));
+            }
+        }
+        let a = self.dense(def.body).ok_or(Error::UnknownBody {
+            field: "body".into(),
+            id: def.body,
+        })?;
+        let b = match def.other {
+            Some(id) => Some(self.dense(id).ok_or(Error::UnknownBody {
+                field: "other".into(),
+                id,
+            })?),
+            None => None,
+        };
+        let pose = |i: usize| {
+            let p = self.bodies[i].pose();
+            (p.position, p.rotation)
+        };
+        let joint = joint::build(def, pose(a), b.map(pose));
+        let id = JointId(self.next_joint_id);
+        self.next_joint_id += 1;
+        self.joints.push(joint);
+        self.joint_ids.push(id);
+        self.wake_around(a);
+        if let Some(b) = b {
+            self.wake_around(b);
+        }
+        self.refresh_joint_links();
+        Ok(id)
+    }
+
+    /// Removes a joint, waking the bodies it held; false if there is no such joint.
+    pub fn remove_joint(&mut self, id: JointId) -> bool {
+        let Some(k) = self.joint_ids.iter().position(|j| *j == id) else {
+            return false;
+        };
+        let joint = self.joints.remove(k);
+        self.joint_ids.remove(k);
+        for body in [Some(joint.def.body), joint.def.other]
+            .into_iter()
+            .flatten()
+        {
+            if let Some(i) = self.dense(body) {
+                self.wake_around(i);
+            }
+        }
+        self.refresh_joint_links();
+        true
+    }
+
+    /// The joint with handle `id`.
+    pub fn joint(&self, id: JointId) -> Result<&Joint> {
+        self.joint_ids
+            .iter()
+            .position(|j| *j == id)
+            .map(|k| &self.joints[k])
+            .ok_or_else(|| Error::invalid("joint", format!("unknown or removed joint {id:?}")))
+    }
+
+    /// The handle of the joint called `name`.
+    pub fn find_joint(&self, name: &str) -> Option<JointId> {
+        self.joints
+            .iter()
+            .position(|j| j.def.name.as_deref() == Some(name))
+            .map(|k| self.joint_ids[k])
+    }
+
+    /// All joints with their handles, in creation order.
+    pub fn joints(&self) -> impl Iterator<Item = (JointId, &Joint)> {
+        self.joint_ids.iter().copied().zip(self.joints.iter())
+    }
+
+    /// Removes every joint attached to `body` (the body is being removed).
+    pub(crate) fn remove_joints_of(&mut self, body: BodyId) {
+        let attached: Vec<JointId> = self
+            .joints()
+            .filter(|(_, j)| j.def.body == body || j.def.other == Some(body))
+            .map(|(id, _)| id)
+            .collect();
+        for id in attached {
+            self.remove_joint(id);
+        }
+    }
+
+    /// Re-derives each joint's dense body indices (broken joints join nothing) and the
+    /// pairs that must not collide.
+    pub(crate) fn refresh_joint_links(&mut self) {
+        let links: Vec<[Option<usize>; 2]> = self
+            .joints
+            .iter()
+            .map(|j| {
+                if j.broken {
+                    [None, None]
+                } else {
+                    [
+                        self.dense(j.def.body),
+                        j.def.other.and_then(|o| self.dense(o)),
+                    ]
+                }
+            })
+            .collect();
+        self.joined_pairs.clear();
+        for (j, link) in self.joints.iter().zip(&links) {
+            if let [Some(a), Some(b)] = *link {
+                if !j.def.collide_connected {
+                    self.joined_pairs.push((a.min(b) as u32, a.max(b) as u32));
+                }
+            }
+        }
+        self.joined_pairs.sort_unstable();
+        self.joined_pairs.dedup();
+        self.joint_bodies = links;
+    }
+}
