@@ -5,7 +5,7 @@
 //! file in `scenes/` is listed here.
 
 /// Name and JSON text of every built-in scene; the seed's free fall first.
-const SCENES: [(&str, &str); 7] = [
+const SCENES: [(&str, &str); 11] = [
     ("free_fall", include_str!("../../../scenes/free_fall.json")),
     ("spring", include_str!("../../../scenes/spring.json")),
     (
@@ -22,6 +22,13 @@ const SCENES: [(&str, &str); 7] = [
     ),
     ("dumbbell", include_str!("../../../scenes/dumbbell.json")),
     ("resting", include_str!("../../../scenes/resting.json")),
+    ("door", include_str!("../../../scenes/door.json")),
+    ("cradle", include_str!("../../../scenes/cradle.json")),
+    (
+        "rope_bridge",
+        include_str!("../../../scenes/rope_bridge.json"),
+    ),
+    ("ragdoll", include_str!("../../../scenes/ragdoll.json")),
 ];
 
 /// The JSON text of the built-in scene `name`.

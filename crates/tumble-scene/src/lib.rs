@@ -16,6 +16,7 @@ mod body;
 pub mod builtin;
 mod error;
 mod force;
+mod joint;
 mod plan;
 mod reader;
 mod shape;
@@ -30,13 +31,14 @@ pub use body::BODY_KINDS;
 pub use builtin::{builtin, builtin_names};
 pub use error::{printable, Result, SceneError};
 pub use force::FORCE_TYPES;
+pub use joint::JOINT_TYPES;
 pub use plan::{RunPlan, MAX_STEPS};
 pub use reader::ROOT;
 pub use shape::SHAPE_TYPES;
 
 use reader::{Node, Obj};
 
-const TOP_KEYS: [&str; 15] = [
+const TOP_KEYS: [&str; 18] = [
     "name",
     "description",
     "gravity",
@@ -45,11 +47,14 @@ const TOP_KEYS: [&str; 15] = [
     "integrator",
     "bodies",
     "forces",
+    "joints",
     "solver",
     "substeps",
     "iterations",
     "contact_hertz",
     "contact_damping_ratio",
+    "joint_hertz",
+    "joint_damping_ratio",
     "length_unit",
     "sleep",
 ];
@@ -170,6 +175,7 @@ fn build(root: &Node<'_>) -> Result<Scene> {
     let mut world = World::try_new(&def).map_err(|e| SceneError::from_engine(e, ""))?;
     let body_names = add_bodies(&obj, &mut world)?;
     add_forces(&obj, &mut world)?;
+    add_joints(&obj, &mut world)?;
     Ok(Scene {
         name,
         description,
@@ -193,7 +199,8 @@ pub fn parse_solver(name: &str) -> Result<SolverKind> {
     })
 }
 
-/// `solver`, `substeps`, `iterations`, `contact_hertz`, `contact_damping_ratio`. Values are
+/// `solver`, `substeps`, `iterations`, `contact_hertz`, `contact_damping_ratio`,
+/// `joint_hertz`, `joint_damping_ratio`. Values are
 /// checked by the engine (`World::try_new`), which names the same keys.
 fn solver_settings(obj: &Obj<'_>) -> Result<SolverSettings> {
     let d = SolverSettings::default();
@@ -216,6 +223,10 @@ fn solver_settings(obj: &Obj<'_>) -> Result<SolverSettings> {
         contact_damping_ratio: obj
             .real("contact_damping_ratio")?
             .unwrap_or(d.contact_damping_ratio),
+        joint_hertz: obj.real("joint_hertz")?.unwrap_or(d.joint_hertz),
+        joint_damping_ratio: obj
+            .real("joint_damping_ratio")?
+            .unwrap_or(d.joint_damping_ratio),
         ..d
     })
 }
@@ -255,6 +266,19 @@ fn add_bodies(obj: &Obj<'_>, world: &mut World) -> Result<Vec<String>> {
             .map_err(|e| SceneError::from_engine(e, node.path()))?;
     }
     Ok(names)
+}
+
+fn add_joints(obj: &Obj<'_>, world: &mut World) -> Result<()> {
+    let Some(joints) = obj.get("joints") else {
+        return Ok(());
+    };
+    for node in joints.array()? {
+        let def = joint::joint(&node, world)?;
+        world
+            .create_joint(&def)
+            .map_err(|e| SceneError::from_engine(e, node.path()))?;
+    }
+    Ok(())
 }
 
 fn add_forces(obj: &Obj<'_>, world: &mut World) -> Result<()> {

@@ -34,6 +34,11 @@ impl<'a> Node<'a> {
         }
     }
 
+    /// Whether the value is JSON null.
+    pub fn is_null(&self) -> bool {
+        self.value.is_null()
+    }
+
     /// An error about this value.
     pub fn err(&self, reason: impl Into<String>) -> SceneError {
         SceneError::new(self.path(), reason)

@@ -542,6 +542,7 @@ fn solve_limit(
     let delta =
         -row.mass(&fr.sa, &fr.sb) * mass_scale * (row.velocity(a, b) + bias) - impulse_scale * acc;
     let total = (acc + delta).max(0.0);
+
     row.apply(total - acc, &fr.sa, &fr.sb, a, b);
     total
 }

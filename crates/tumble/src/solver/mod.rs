@@ -134,6 +134,7 @@ pub(crate) struct Solver {
     joints: Vec<JointConstraint>,
     /// Bodies whose kick is split around the drift (see `split_kicks`).
     split_kick: Vec<bool>,
+
     wrench: Vec<Wrench>,
     motions: Vec<Motion>,
 }
@@ -282,6 +283,7 @@ impl Solver {
     /// The joints that join at least one body the solver moves, in creation order.
     fn prepare_joints(&mut self, bodies: &[Body], joints: &[Joint], links: &[[Option<usize>; 2]]) {
         self.joints.clear();
+
         for (i, (joint, link)) in joints.iter().zip(links).enumerate() {
             if joint.broken {
                 continue;
