@@ -1,7 +1,8 @@
 //! Tumble against rapier3d on the same scenes.
 //!
 //! A scene is described once, engine-neutrally and in `f64` ([`SceneSpec`]: every body's
-//! kind, shape, position and orientation), then built in each engine by
+//! kind, shape, position and orientation, and every ball joint's bodies and anchors), then
+//! built in each engine by
 //! [`tumble_engine::build`], [`rapier_f32::build`] or [`rapier_f64::build`], so the two
 //! engines start from the same numbers. Every engine gets the same settings:
 //!
@@ -16,12 +17,27 @@
 //! | gravity     | (0, −9.81, 0) m/s²                       | (0, −9.81, 0) m/s²                     |
 //! | sleeping    | `WorldDef { sleep: false }`              | `RigidBodyBuilder::can_sleep(false)`   |
 //! | threads     | one                                      | one (no `parallel` feature)            |
+//! | ball joints | `JointKind::Ball` without limits, `collide_connected: false` (default) | `SphericalJointBuilder` as an impulse joint, `contacts_enabled(false)` (rapier's default is true) |
 //!
 //! Everything else is each engine's default (rapier: contact recycling and clustering on,
-//! the simplified friction model, CCD against fixed colliders; Tumble: symplectic Euler,
-//! CCD against static bodies).
+//! the simplified friction model, CCD against fixed colliders, joints stiff (10⁶ Hz,
+//! ζ = 1) and not warm-started; Tumble: symplectic Euler, CCD against static bodies,
+//! joints' drift corrected at 1000 Hz capped at a quarter of the substep rate, ζ = 0.5,
+//! and warm-started).
+//!
+//! | scene     | what                                                    | built by          |
+//! |-----------|---------------------------------------------------------|-------------------|
+//! | `pyramid` | 385 unit boxes in a 10×10-base pyramid on the ground    | [`pyramid`]       |
+//! | `rain`    | 2,000 spheres and boxes dropped into a walled container | [`rain`]          |
+//! | `joints`  | 30 × 30 balls joined by 1,739 ball joints into a net hanging from one edge | [`joint_grid()`] |
 
 use std::time::Instant;
+
+pub mod joint_grid;
+pub use joint_grid::{
+    joint_grid, measure_joint_grid, JointGridResult, JOINT_GRID_SETTLE_STEPS,
+    JOINT_GRID_TIMED_STEPS,
+};
 
 /// Time step of every scene (s).
 pub const DT: f64 = 1.0 / 60.0;
@@ -58,13 +74,25 @@ pub struct BodySpec {
     pub rotation: [f64; 3],
 }
 
-/// A scene: its bodies, static ones included, in creation order.
+/// A ball (spherical) joint between two bodies of a scene: the two anchors are held
+/// together, rotation is free, and the two bodies do not collide with each other.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BallJointSpec {
+    /// Indices of the two bodies in [`SceneSpec::bodies`].
+    pub bodies: [usize; 2],
+    /// Each body's anchor, in that body's frame (m).
+    pub anchors: [[f64; 3]; 2],
+}
+
+/// A scene: its bodies, static ones included, in creation order, and its joints.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneSpec {
-    /// Short name (`pyramid`, `rain`).
+    /// Short name (`pyramid`, `rain`, `joints`).
     pub name: &'static str,
     /// Every body, static ones included.
     pub bodies: Vec<BodySpec>,
+    /// Every joint, in creation order (after all the bodies).
+    pub joints: Vec<BallJointSpec>,
 }
 
 impl SceneSpec {
@@ -108,6 +136,7 @@ pub fn pyramid() -> SceneSpec {
     SceneSpec {
         name: "pyramid",
         bodies,
+        joints: Vec::new(),
     }
 }
 
@@ -187,6 +216,7 @@ pub fn rain() -> SceneSpec {
     SceneSpec {
         name: "rain",
         bodies,
+        joints: Vec::new(),
     }
 }
 
@@ -200,6 +230,15 @@ pub trait Simulation {
     fn step(&mut self);
     /// Positions of the dynamic bodies, in scene order (m).
     fn dynamic_positions(&self) -> Vec<[f64; 3]>;
+    /// For each joint, in scene order, the distance between its two anchors in world
+    /// coordinates (m): zero for a joint that holds.
+    fn joint_gaps(&self) -> Vec<f64>;
+}
+
+/// Distance between two points (m).
+pub fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
 }
 
 /// The precision of `T` as a name.
@@ -213,7 +252,7 @@ fn precision_of<T>() -> &'static str {
 
 /// Tumble, at the precision of `tumble::Real` (f64 unless built with `--features tumble/f32`).
 pub mod tumble_engine {
-    use super::{BodySpec, SceneSpec, ShapeSpec, Simulation};
+    use super::{BallJointSpec, BodySpec, SceneSpec, ShapeSpec, Simulation};
     use tumble::prelude::*;
     use tumble::SolverSettings;
 
@@ -225,6 +264,8 @@ pub mod tumble_engine {
         pub bodies: Vec<BodyId>,
         /// The dynamic bodies, in scene order.
         pub dynamic_bodies: Vec<BodyId>,
+        /// Every joint, in scene order.
+        pub joints: Vec<JointId>,
     }
 
     fn v(a: [f64; 3]) -> Vec3 {
@@ -261,6 +302,29 @@ pub mod tumble_engine {
         }
     }
 
+    /// A ball joint without limits; joined bodies do not collide (`collide_connected`
+    /// false, the default).
+    fn joint_def(j: &BallJointSpec, bodies: &[BodyId]) -> JointDef {
+        let mut def = JointDef::new(
+            JointKind::Ball {
+                cone: None,
+                twist: None,
+            },
+            bodies[j.bodies[0]],
+        );
+        def.anchor = v(j.anchors[0]);
+        def.other = Some(bodies[j.bodies[1]]);
+        def.other_anchor = v(j.anchors[1]);
+        def
+    }
+
+    /// World position of the point `local` of `body` (m).
+    fn world_point(world: &World, body: BodyId, local: Vec3) -> [f64; 3] {
+        let b = world.body(body).expect("live body");
+        let p = b.position() + b.orientation() * local;
+        [wide(p.x), wide(p.y), wide(p.z)]
+    }
+
     /// Builds `spec`: 4 substeps of 1 iteration, sleeping off, gravity −9.81 m/s².
     pub fn build(spec: &SceneSpec) -> TumbleScene {
         let mut world = World::try_new(&WorldDef {
@@ -285,10 +349,20 @@ pub mod tumble_engine {
                 dynamic_bodies.push(id);
             }
         }
+        let joints = spec
+            .joints
+            .iter()
+            .map(|j| {
+                world
+                    .create_joint(&joint_def(j, &bodies))
+                    .expect("valid joint")
+            })
+            .collect();
         TumbleScene {
             world,
             bodies,
             dynamic_bodies,
+            joints,
         }
     }
 
@@ -311,6 +385,19 @@ pub mod tumble_engine {
                 })
                 .collect()
         }
+        fn joint_gaps(&self) -> Vec<f64> {
+            self.joints
+                .iter()
+                .map(|id| {
+                    let def = self.world.joint(*id).expect("live joint").def();
+                    let other = def.other.expect("joined to a body");
+                    super::distance(
+                        world_point(&self.world, def.body, def.anchor),
+                        world_point(&self.world, other, def.other_anchor),
+                    )
+                })
+                .collect()
+        }
     }
 }
 
@@ -319,7 +406,7 @@ macro_rules! rapier_engine {
     ($module:ident, $krate:ident, $doc:literal) => {
         #[doc = $doc]
         pub mod $module {
-            use super::{BodySpec, SceneSpec, ShapeSpec, Simulation};
+            use super::{BallJointSpec, BodySpec, SceneSpec, ShapeSpec, Simulation};
             use $krate::prelude::*;
 
             /// A ready rapier world and the handles of its bodies, in scene order.
@@ -330,6 +417,8 @@ macro_rules! rapier_engine {
                 pub bodies: Vec<RigidBodyHandle>,
                 /// The dynamic bodies, in scene order.
                 pub dynamic_bodies: Vec<RigidBodyHandle>,
+                /// Every joint, in scene order.
+                pub joints: Vec<ImpulseJointHandle>,
             }
 
             fn v(a: [f64; 3]) -> Vector {
@@ -362,6 +451,21 @@ macro_rules! rapier_engine {
                     .can_sleep(false)
             }
 
+            /// A spherical impulse joint. Contacts between the joined bodies are switched
+            /// off explicitly: rapier's joints leave them on by default.
+            fn joint(j: &BallJointSpec) -> SphericalJointBuilder {
+                SphericalJointBuilder::new()
+                    .local_anchor1(v(j.anchors[0]))
+                    .local_anchor2(v(j.anchors[1]))
+                    .contacts_enabled(false)
+            }
+
+            /// World position of the point `local` of `body` (m).
+            fn world_point(world: &PhysicsWorld, body: RigidBodyHandle, local: Vector) -> [f64; 3] {
+                let p = world.bodies[body].position().transform_point(local);
+                [p.x as f64, p.y as f64, p.z as f64]
+            }
+
             /// The integration parameters of every scene: dt = 1/60 s and 4 substeps, each
             /// one biased solve and one relax (stabilisation) pass.
             pub fn integration_parameters() -> IntegrationParameters {
@@ -388,10 +492,23 @@ macro_rules! rapier_engine {
                         dynamic_bodies.push(handle);
                     }
                 }
+                let joints = spec
+                    .joints
+                    .iter()
+                    .map(|j| {
+                        world.impulse_joints.insert(
+                            bodies[j.bodies[0]],
+                            bodies[j.bodies[1]],
+                            joint(j),
+                            true,
+                        )
+                    })
+                    .collect();
                 RapierScene {
                     world,
                     bodies,
                     dynamic_bodies,
+                    joints,
                 }
             }
 
@@ -411,6 +528,18 @@ macro_rules! rapier_engine {
                         .map(|h| {
                             let p = self.world.bodies[*h].translation();
                             [p.x as f64, p.y as f64, p.z as f64]
+                        })
+                        .collect()
+                }
+                fn joint_gaps(&self) -> Vec<f64> {
+                    self.joints
+                        .iter()
+                        .map(|h| {
+                            let j = self.world.impulse_joints.get(*h).expect("live joint");
+                            super::distance(
+                                world_point(&self.world, j.body1(), j.data.local_anchor1()),
+                                world_point(&self.world, j.body2(), j.data.local_anchor2()),
+                            )
                         })
                         .collect()
                 }
@@ -503,10 +632,7 @@ pub fn max_displacement(before: &[[f64; 3]], after: &[[f64; 3]]) -> f64 {
     before
         .iter()
         .zip(after)
-        .map(|(a, b)| {
-            let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-            (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
-        })
+        .map(|(a, b)| distance(*a, *b))
         .fold(
             0.0,
             |m: f64, d| if d.is_nan() { f64::NAN } else { m.max(d) },

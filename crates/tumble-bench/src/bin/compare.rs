@@ -1,10 +1,13 @@
 //! Runs each scene in Tumble and in rapier3d (f64 and f32) in the same process and prints
-//! ms per step, the pyramid's drift and the ratio Tumble / rapier at Tumble's precision.
+//! ms per step, a check of each run (the pyramid's drift, where the rain landed, the joint
+//! grid's largest joint gap and lowest point) and the ratio Tumble / rapier at Tumble's
+//! precision.
 //!
 //! ```sh
 //! cargo run --release -p tumble-bench --bin compare                       # Tumble f64
 //! cargo run --release -p tumble-bench --bin compare --features tumble/f32 # Tumble f32
 //! cargo run --release -p tumble-bench --bin compare -- --scene rain --repeats 3
+//! cargo run --release -p tumble-bench --bin compare -- --scene joints
 //! ```
 //!
 //! Every engine first steps the pyramid 30 times untimed (warm-up). Then, with
@@ -15,12 +18,16 @@
 
 use std::process::ExitCode;
 use tumble_bench::{
-    count_rain, measure_pyramid, median, pyramid, rain, rapier_f32, rapier_f64, timed_steps,
-    tumble_engine, SceneSpec, Simulation, PYRAMID_SETTLE_STEPS, PYRAMID_TIMED_STEPS,
-    RAIN_TIMED_STEPS,
+    count_rain, joint_grid, measure_joint_grid, measure_pyramid, median, pyramid, rain, rapier_f32,
+    rapier_f64, timed_steps, tumble_engine, SceneSpec, Simulation, JOINT_GRID_SETTLE_STEPS,
+    JOINT_GRID_TIMED_STEPS, PYRAMID_SETTLE_STEPS, PYRAMID_TIMED_STEPS, RAIN_TIMED_STEPS,
 };
 
-const USAGE: &str = "usage: compare [--scene pyramid|rain|all] [--repeats N] [--no-other-precision]
+/// Every scene, in the order `all` runs them.
+const SCENES: [&str; 3] = ["pyramid", "rain", "joints"];
+
+const USAGE: &str =
+    "usage: compare [--scene pyramid|rain|joints|all] [--repeats N] [--no-other-precision]
 
   --scene S              run one scene (default: all)
   --repeats N            runs per engine and scene, interleaved; medians are printed (default 3)
@@ -37,7 +44,7 @@ struct Options {
 
 fn parse(args: &[String]) -> Result<Options, String> {
     let mut o = Options {
-        scenes: vec!["pyramid", "rain"],
+        scenes: SCENES.to_vec(),
         repeats: 3,
         other_precision: true,
     };
@@ -46,9 +53,10 @@ fn parse(args: &[String]) -> Result<Options, String> {
         match a.as_str() {
             "--scene" => {
                 o.scenes = match it.next().map(String::as_str) {
-                    Some("pyramid") => vec!["pyramid"],
-                    Some("rain") => vec!["rain"],
-                    Some("all") => vec!["pyramid", "rain"],
+                    Some("all") => SCENES.to_vec(),
+                    Some(name) if SCENES.contains(&name) => {
+                        SCENES.iter().copied().filter(|s| *s == name).collect()
+                    }
                     other => return Err(format!("--scene: unknown scene {other:?}")),
                 }
             }
@@ -98,22 +106,38 @@ fn run_once(scene: &str, spec: &SceneSpec, engine: Engine, row: &mut Row) {
     let mut sim = engine.build(spec);
     row.engine = sim.engine();
     row.precision = sim.precision();
-    let timing = if scene == "pyramid" {
-        let r = measure_pyramid(sim.as_mut(), PYRAMID_SETTLE_STEPS, PYRAMID_TIMED_STEPS);
-        row.note = format!(
-            "drift {:.2} mm (from t = 0: {:.2} mm)",
-            r.drift * 1e3,
-            r.drift_from_start * 1e3
-        );
-        r.timing
-    } else {
-        let t = timed_steps(sim.as_mut(), RAIN_TIMED_STEPS);
-        let c = count_rain(&sim.dynamic_positions());
-        row.note = format!(
-            "inside {} / outside {} / off floor {}",
-            c.inside, c.outside, c.off_floor
-        );
-        t
+    let timing = match scene {
+        "pyramid" => {
+            let r = measure_pyramid(sim.as_mut(), PYRAMID_SETTLE_STEPS, PYRAMID_TIMED_STEPS);
+            row.note = format!(
+                "drift {:.2} mm (from t = 0: {:.2} mm)",
+                r.drift * 1e3,
+                r.drift_from_start * 1e3
+            );
+            r.timing
+        }
+        "rain" => {
+            let t = timed_steps(sim.as_mut(), RAIN_TIMED_STEPS);
+            let c = count_rain(&sim.dynamic_positions());
+            row.note = format!(
+                "inside {} / outside {} / off floor {}",
+                c.inside, c.outside, c.off_floor
+            );
+            t
+        }
+        _ => {
+            let r = measure_joint_grid(
+                sim.as_mut(),
+                JOINT_GRID_SETTLE_STEPS,
+                JOINT_GRID_TIMED_STEPS,
+            );
+            row.note = format!(
+                "max joint gap {:.2} mm, lowest y {:.3} m",
+                r.max_gap * 1e3,
+                r.lowest_y
+            );
+            r.timing
+        }
     };
     row.means.push(timing.mean());
     row.medians.push(timing.median());
@@ -151,8 +175,10 @@ fn main() -> ExitCode {
     println!(
         "pyramid: steps {PYRAMID_SETTLE_STEPS}-{} timed, drift = largest box displacement \
          t = 1 s -> 11 s (and t = 0 -> 11 s);\nrain: first {RAIN_TIMED_STEPS} steps timed, \
-         where the bodies are after them",
-        PYRAMID_SETTLE_STEPS + PYRAMID_TIMED_STEPS
+         where the bodies are after them;\njoints: steps {JOINT_GRID_SETTLE_STEPS}-{} timed, \
+         largest distance between a joint's two anchors and lowest body after them",
+        PYRAMID_SETTLE_STEPS + PYRAMID_TIMED_STEPS,
+        JOINT_GRID_SETTLE_STEPS + JOINT_GRID_TIMED_STEPS
     );
     println!();
     for engine in &engines {
@@ -166,10 +192,10 @@ fn main() -> ExitCode {
         "scene", "engine", "prec", "ms/step", "median-step", "Tumble/rapier"
     );
     for scene in &options.scenes {
-        let spec = if *scene == "pyramid" {
-            pyramid()
-        } else {
-            rain()
+        let spec = match *scene {
+            "pyramid" => pyramid(),
+            "rain" => rain(),
+            _ => joint_grid(),
         };
         let mut rows: Vec<Row> = engines
             .iter()
