@@ -8,8 +8,11 @@ use crate::{BallJointSpec, BodySpec, SceneSpec, ShapeSpec, Simulation, Timing};
 pub const JOINT_GRID_SIZE: usize = 30;
 /// Distance between neighbouring bodies (m); each joint's anchors sit halfway.
 pub const JOINT_GRID_SPACING: f64 = 1.0;
-/// Radius of each ball (m).
-pub const JOINT_GRID_RADIUS: f64 = 0.1;
+/// Radius of each ball (m), rapier's `joint_ball3` value. With 0.1 m balls (anchors five
+/// radii out, so turning dominates each joint's effective mass 60 to 1) Tumble's default
+/// settings tear the net apart at about step 120 as its tension peaks; 8 substeps or 2
+/// iterations hold it (gaps ≤ 6.5 cm and 0.5 m). See docs/integrators.md, "Joints".
+pub const JOINT_GRID_RADIUS: f64 = 0.4;
 /// Untimed steps before the timed window.
 pub const JOINT_GRID_SETTLE_STEPS: usize = 30;
 /// Timed steps (five simulated seconds).
@@ -22,7 +25,7 @@ fn is_fixed(column: usize, row: usize) -> bool {
     row == 0 && (column.is_multiple_of(4) || column == JOINT_GRID_SIZE - 1)
 }
 
-/// 30 × 30 balls (radius 0.1 m) 1 m apart on the plane y = 0, body `row * 30 + column` at
+/// 30 × 30 balls (radius 0.4 m) 1 m apart on the plane y = 0, body `row * 30 + column` at
 /// x = column − 14.5, z = row. Nine bodies of the row z = 0 are fixed (columns 0, 4, …,
 /// 28 and 29, rapier's pattern), so the net hangs from that edge and swings down.
 ///

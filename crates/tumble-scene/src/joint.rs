@@ -1,9 +1,7 @@
 //! Joints: one entry of the `joints` array. Bodies are referred to by name; `other`
 //! omitted or null joins `body` to the world.
 
-use tumble::{
-    BodyId, JointDef, JointKind, JointSpring, Motor, Quat, Real, Vec3, World,
-};
+use tumble::{BodyId, JointDef, JointKind, JointSpring, Motor, Quat, Real, Vec3, World};
 
 use crate::error::{printable, Result};
 use crate::reader::{Node, Obj};
@@ -118,7 +116,9 @@ fn pose(world: &World, id: Option<BodyId>) -> (Vec3, Quat) {
 
 /// `[lower, upper]`, if present.
 fn range(obj: &Obj<'_>, key: &str) -> Result<Option<[Real; 2]>> {
-    obj.get(key).map(|n| n.reals::<2>("[lower, upper]")).transpose()
+    obj.get(key)
+        .map(|n| n.reals::<2>("[lower, upper]"))
+        .transpose()
 }
 
 /// `{"speed": .., "max_torque" | "max_force": ..}`.
