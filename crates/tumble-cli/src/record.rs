@@ -17,6 +17,8 @@ pub const TRAJECTORY_HEADER: &str = "time,body,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,
 /// Header of the contacts file.
 pub const CONTACT_IMPULSES_HEADER: &str =
     "time,body_a,body_b,x,y,z,nx,ny,nz,normal_impulse,tangent_impulse";
+/// Header of the joints file.
+pub const JOINT_REACTIONS_HEADER: &str = "time,joint,body,other,fx,fy,fz,tx,ty,tz,broken";
 /// Header of the diagnostics file.
 pub const DIAGNOSTICS_HEADER: &str = "time,kinetic,potential,total,px,py,pz,lx,ly,lz";
 
@@ -159,6 +161,46 @@ impl CsvFile {
                     ),
                 )?;
             }
+        }
+        Ok(())
+    }
+
+    /// A row per joint: its label (name, or index in creation order), its bodies (`world`
+    /// for none), and the force and torque it applied to `other` over the last step
+    /// (N, N·m; the force on `body` is the opposite), and whether it has broken.
+    pub fn joints(&mut self, time: Real, world: &World, labels: &[String]) -> Result<(), Failure> {
+        let index: std::collections::BTreeMap<tumble::BodyId, usize> = world
+            .body_ids()
+            .iter()
+            .enumerate()
+            .map(|(i, id)| (*id, i))
+            .collect();
+        let label = |id: Option<tumble::BodyId>| match id {
+            None => "world",
+            Some(id) => index
+                .get(&id)
+                .and_then(|i| labels.get(*i))
+                .map_or("", String::as_str),
+        };
+        for (k, (_, j)) in world.joints().enumerate() {
+            let (f, t) = (j.reaction_force(), j.reaction_torque());
+            let name = j.name().map_or_else(|| k.to_string(), str::to_string);
+            self.row(
+                time,
+                format_args!(
+                    "{},{},{},{},{},{},{},{},{},{}",
+                    csv_text(&name),
+                    csv_text(label(Some(j.body()))),
+                    csv_text(label(j.other())),
+                    Num(f.x),
+                    Num(f.y),
+                    Num(f.z),
+                    Num(t.x),
+                    Num(t.y),
+                    Num(t.z),
+                    u8::from(j.is_broken())
+                ),
+            )?;
         }
         Ok(())
     }
