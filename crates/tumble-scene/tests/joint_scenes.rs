@@ -24,16 +24,19 @@ fn run_scene(name: &str) -> (tumble_scene::Scene, Real) {
 fn joint_gap(w: &World) -> Real {
     w.joints()
         .filter(|(_, j)| !j.is_broken() && !matches!(j.kind(), JointKind::Distance { .. }))
-        .map(|(_, j)| {
-            let d = j.def();
-            let a = w.body(d.body).unwrap().pose().transform_point(d.anchor);
-            let b = match d.other {
-                Some(o) => w.body(o).unwrap().pose().transform_point(d.other_anchor),
-                None => d.other_anchor,
-            };
-            (a - b).length()
-        })
+        .map(|(_, j)| anchor_distance(w, j))
         .fold(0.0, Real::max)
+}
+
+/// How far apart a joint's two anchors are now.
+fn anchor_distance(w: &World, j: &tumble::Joint) -> Real {
+    let d = j.def();
+    let a = w.body(d.body).unwrap().pose().transform_point(d.anchor);
+    let b = match d.other {
+        Some(o) => w.body(o).unwrap().pose().transform_point(d.other_anchor),
+        None => d.other_anchor,
+    };
+    (a - b).length()
 }
 
 fn body<'a>(w: &'a World, name: &str) -> &'a Body {
@@ -86,15 +89,7 @@ fn the_cradle_passes_the_swing_to_the_last_ball() {
 fn rope_lengths(w: &World) -> Vec<Real> {
     w.joints()
         .filter(|(_, j)| matches!(j.kind(), JointKind::Distance { .. }))
-        .map(|(_, j)| {
-            let d = j.def();
-            let a = w.body(d.body).unwrap().pose().transform_point(d.anchor);
-            let b = match d.other {
-                Some(o) => w.body(o).unwrap().pose().transform_point(d.other_anchor),
-                None => d.other_anchor,
-            };
-            (a - b).length()
-        })
+        .map(|(_, j)| anchor_distance(w, j))
         .collect()
 }
 
