@@ -24,7 +24,7 @@ mod softness;
 pub use softness::Softness;
 
 use body::{BodySim, BodyState};
-use contact::{BiasRule, ContactConstraint, PairData};
+use contact::{BiasRule, ContactConstraint, PairData, Points};
 
 use crate::body::{Body, BodyKind};
 use crate::contact_cache::Contact;
@@ -116,6 +116,7 @@ pub(crate) struct Solver {
     start_states: Vec<BodyState>,
     moving: Vec<bool>,
     constraints: Vec<ContactConstraint>,
+    points: Points,
     wrench: Vec<Wrench>,
     motions: Vec<Motion>,
 }
@@ -145,36 +146,35 @@ impl Solver {
         for i in 0..substeps {
             self.kick(input.system, input.time + i as Real * h, h);
             for c in &self.constraints {
-                c.warm_start(&mut self.states);
+                c.warm_start(&self.points.hot, &mut self.states);
             }
             for _ in 0..input.settings.iterations {
-                for c in &mut self.constraints {
-                    c.solve(&mut self.states, &rule, true);
+                for c in &self.constraints {
+                    c.solve(&mut self.points, &mut self.states, &rule, true);
                 }
             }
             self.drift(bodies, h);
             if input.settings.kind == SolverKind::SoftStep {
                 for _ in 0..input.settings.iterations {
-                    for c in &mut self.constraints {
-                        c.solve(&mut self.states, &rule, false);
+                    for c in &self.constraints {
+                        c.solve(&mut self.points, &mut self.states, &rule, false);
                     }
                 }
             }
-            for c in &mut self.constraints {
-                c.add_to_totals();
-            }
+            ContactConstraint::add_to_totals(&mut self.points);
         }
         self.moving.clear();
         self.moving.extend(self.sims.iter().map(|s| s.moves));
         restitution::resolve_bounces(
-            &mut self.constraints,
+            &self.constraints,
+            &mut self.points,
             &mut self.states,
             &self.start_states,
             &self.moving,
             input.scales.restitution_threshold,
         );
         for c in &self.constraints {
-            c.store_impulses(&mut contacts[c.contact]);
+            c.store_impulses(&self.points, &mut contacts[c.contact]);
         }
         for ((m, sim), (state, body)) in motions
             .iter_mut()
@@ -196,6 +196,7 @@ impl Solver {
 
     fn prepare(&mut self, bodies: &[Body], contacts: &[Contact]) {
         self.constraints.clear();
+        self.points.clear();
         for i in self.colour_order(contacts) {
             let c = &contacts[i];
             let (a, b) = (c.index_a as usize, c.index_b as usize);
@@ -214,8 +215,8 @@ impl Solver {
                 i,
                 c,
                 &pair,
-                &self.sims,
-                &self.states,
+                (&self.sims, &self.states),
+                &mut self.points,
             ));
         }
     }
