@@ -66,6 +66,10 @@ pub(crate) struct ContactCache {
     events: Vec<ContactEvent>,
     pairs: Vec<(u32, u32)>,
     manifolds: Vec<Manifold>,
+    /// The touching body pairs of `contacts` and of `previous`, sorted: last update's
+    /// list is this one's `before`, so each update sorts only its own.
+    touching: Vec<(BodyId, BodyId)>,
+    touching_before: Vec<(BodyId, BodyId)>,
 }
 
 impl ContactCache {
@@ -93,6 +97,7 @@ impl ContactCache {
         let old = Sorted {
             list: &self.previous,
             order: &self.order,
+            hint: std::cell::Cell::new(0),
         };
         self.contacts.clear();
         for &(a, b) in &self.pairs {
@@ -127,15 +132,15 @@ impl ContactCache {
                 self.manifolds.retain(|m| !m.is_empty());
             }
             for manifold in &self.manifolds {
-                let mut contact = Contact {
+                self.contacts.push(Contact {
                     body_a: ids[a],
                     body_b: ids[b],
                     manifold: *manifold,
                     index_a: a as u32,
                     index_b: b as u32,
-                };
-                warm_start(&mut contact, &old, (&body_a.pose(), &body_b.pose()));
-                self.contacts.push(contact);
+                });
+                let contact = self.contacts.last_mut().expect("just pushed");
+                warm_start(contact, &old, (&body_a.pose(), &body_b.pose()));
             }
         }
         self.find_events();
@@ -147,19 +152,19 @@ impl ContactCache {
     }
 
     fn find_events(&mut self) {
-        let touching = |list: &[Contact]| {
-            let mut pairs: Vec<(BodyId, BodyId)> = list
+        std::mem::swap(&mut self.touching, &mut self.touching_before);
+        self.touching.clear();
+        self.touching.extend(
+            self.contacts
                 .iter()
                 .filter(|c| !c.manifold.is_empty())
-                .map(|c| (c.body_a, c.body_b))
-                .collect();
-            pairs.sort();
-            pairs.dedup();
-            pairs
-        };
-        let (now, before) = (touching(&self.contacts), touching(&self.previous));
+                .map(|c| (c.body_a, c.body_b)),
+        );
+        self.touching.sort();
+        self.touching.dedup();
+        let (now, before) = (&self.touching, &self.touching_before);
         self.events.clear();
-        for &(a, b) in &now {
+        for &(a, b) in now {
             if before.binary_search(&(a, b)).is_err() {
                 self.events.push(ContactEvent {
                     kind: ContactEventKind::Begin,
@@ -168,7 +173,7 @@ impl ContactCache {
                 });
             }
         }
-        for &(a, b) in &before {
+        for &(a, b) in before {
             if now.binary_search(&(a, b)).is_err() {
                 self.events.push(ContactEvent {
                     kind: ContactEventKind::End,
@@ -202,6 +207,7 @@ impl ContactCache {
             }
         }
         self.contacts.retain(|c| c.body_a != id && c.body_b != id);
+        self.touching.retain(|&(a, b)| a != id && b != id);
         let shift = |i: &mut u32| {
             if *i as usize > index {
                 *i -= 1;
@@ -261,6 +267,9 @@ fn drop_covered_points(
 struct Sorted<'a> {
     list: &'a [Contact],
     order: &'a [u32],
+    /// Where the last `find` ended: the broad phase lists pairs in the same order every
+    /// step, so the next key is usually the next entry and the binary search is skipped.
+    hint: std::cell::Cell<usize>,
 }
 
 impl Sorted<'_> {
@@ -270,9 +279,17 @@ impl Sorted<'_> {
 
     /// The contact with exactly this key.
     fn find(&self, key: (BodyId, BodyId, u32, u32)) -> Option<&Contact> {
+        let h = self.hint.get();
+        // The first entry with the key, as the search below would return.
+        if h < self.order.len() && self.at(h).key() == key && (h == 0 || self.at(h - 1).key() < key)
+        {
+            self.hint.set(h + 1);
+            return Some(self.at(h));
+        }
         let k = self
             .order
             .partition_point(|&i| self.list[i as usize].key() < key);
+        self.hint.set(k + 1);
         (k < self.order.len() && self.at(k).key() == key).then(|| self.at(k))
     }
 
@@ -317,7 +334,7 @@ fn warm_start(contact: &mut Contact, previous: &Sorted<'_>, poses: (&Pose, &Pose
         p.anchor_b = poses.1.inverse_transform_point(mid);
         p.anchored = true;
     };
-    let Some(old) = previous.find(contact.key()).map(|c| c.manifold) else {
+    let Some(old) = previous.find(contact.key()).map(|c| &c.manifold) else {
         contact
             .manifold
             .points_mut()
@@ -325,7 +342,6 @@ fn warm_start(contact: &mut Contact, previous: &Sorted<'_>, poses: (&Pose, &Pose
             .for_each(anchor_here);
         return;
     };
-    let old = &old;
     let mid = |a: Vec3, b: Vec3| (a + b) * 0.5;
     for p in contact.manifold.points_mut() {
         let here = mid(p.point_a, p.point_b);
