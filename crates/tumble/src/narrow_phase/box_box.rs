@@ -136,10 +136,17 @@ struct Query {
     dir: Vec3,
 }
 
+/// The axes of the frame `pb` seen in the frame `pa`. Written out: `AXES.map` was left
+/// as a call per axis, a few percent of a pyramid's step.
+fn axes_in(pa: &Pose, pb: &Pose) -> [Vec3; 3] {
+    let f = |e: Vec3| pa.inverse_transform_vector(pb.transform_vector(e));
+    [f(AXES[0]), f(AXES[1]), f(AXES[2])]
+}
+
 /// Box (half extents `ha`) at `pa` against box at `pb`.
 pub fn box_box(ha: Vec3, pa: &Pose, hb: Vec3, pb: &Pose, margin: Real, out: &mut Manifold) -> bool {
     // B's axes and centre in A's frame.
-    let b_axes = AXES.map(|e| pa.inverse_transform_vector(pb.transform_vector(e)));
+    let b_axes = axes_in(pa, pb);
     let t = pa.inverse_transform_point(pb.position);
     let Some([Some(face_a), Some(face_b), edge]) = separating_axes(ha, hb, &b_axes, t, margin)
     else {
@@ -330,10 +337,7 @@ fn face_contact(
     let (k, positive) = face;
     let sk = if positive { 1.0 } else { -1.0 };
     // The incident box in the reference frame.
-    let axes = AXES.map(|e| {
-        rf.pose
-            .inverse_transform_vector(inc.pose.transform_vector(e))
-    });
+    let axes = axes_in(rf.pose, inc.pose);
     let centre = rf.pose.inverse_transform_point(inc.pose.position);
 
     // Incident face: the axis most parallel to the reference normal sk·e_k, on the side
@@ -453,7 +457,12 @@ fn edge_contact(
     let a0 = vertex(a.he, sa);
     sa[i] = true;
     let a1 = vertex(a.he, sa);
-    let mut sb = edges.b_axes.map(|axis| dir.dot(axis) <= 0.0);
+    let b = &edges.b_axes;
+    let mut sb = [
+        dir.dot(b[0]) <= 0.0,
+        dir.dot(b[1]) <= 0.0,
+        dir.dot(b[2]) <= 0.0,
+    ];
     sb[j] = false;
     let b0 = edges.b_point(sb);
     sb[j] = true;
