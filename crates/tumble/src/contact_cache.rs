@@ -7,7 +7,7 @@ use crate::broad_phase::BroadPhase;
 use crate::geometry::{Aabb, Pose};
 use crate::id::BodyId;
 use crate::math::{Real, Vec3};
-use crate::narrow_phase::{collide, Manifold};
+use crate::narrow_phase::{collide, Manifold, MAX_MANIFOLD_POINTS};
 
 /// A contact manifold between two bodies.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -21,6 +21,78 @@ pub struct Contact {
     /// Dense indices of the two bodies when the contact was found.
     pub(crate) index_a: u32,
     pub(crate) index_b: u32,
+    /// The pair's geometry when the manifold was last computed, to reuse it while the
+    /// bodies hardly move relative to each other.
+    pub(crate) basis: Basis,
+}
+
+/// A manifold's points and normal in the bodies' own frames, and B's pose in A's frame,
+/// as of the narrow-phase run that produced them.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct Basis {
+    relative: Pose,
+    normal: Vec3,
+    points: [(Vec3, Vec3); MAX_MANIFOLD_POINTS],
+}
+
+impl Basis {
+    fn of(m: &Manifold, pa: &Pose, pb: &Pose) -> Basis {
+        let mut points = [(Vec3::ZERO, Vec3::ZERO); MAX_MANIFOLD_POINTS];
+        for (l, p) in points.iter_mut().zip(m.points()) {
+            *l = (
+                pa.inverse_transform_point(p.point_a),
+                pb.inverse_transform_point(p.point_b),
+            );
+        }
+        Basis {
+            relative: pa.inverse().mul(pb),
+            normal: pa.inverse_transform_vector(m.normal),
+            points,
+        }
+    }
+
+    /// Whether B sits within `tolerance` (m) and `REUSE_ANGLE` of where it sat in A's
+    /// frame when the manifold was computed.
+    fn holds(&self, relative: &Pose, tolerance: Real) -> bool {
+        let turn = relative.rotation * self.relative.rotation.inverse();
+        (relative.position - self.relative.position).length_squared() < tolerance * tolerance
+            && Vec3::new(turn.x, turn.y, turn.z).length_squared()
+                < (0.5 * REUSE_ANGLE) * (0.5 * REUSE_ANGLE)
+    }
+
+    /// The manifold moved rigidly with the bodies to poses `pa`, `pb`.
+    fn place(&self, m: &mut Manifold, pa: &Pose, pb: &Pose) {
+        m.normal = pa.transform_vector(self.normal);
+        let n = m.normal;
+        for (p, &(la, lb)) in m.points_mut().iter_mut().zip(&self.points) {
+            p.point_a = pa.transform_point(la);
+            p.point_b = pb.transform_point(lb);
+            p.separation = (p.point_b - p.point_a).dot(n);
+        }
+    }
+}
+
+/// How far (as a fraction of the contact margin) and how much (rad) a pair may move
+/// relative to itself before its manifold is computed again. Its points then move rigidly
+/// with the bodies: a resting pair's separations stay exact to first order, and the
+/// points are never more than ~20 µm (50 µm at a 0.5 m lever) from the clipped ones.
+/// Resting piles skip most of their narrow phase; anything sliding, rolling or falling
+/// moves more than this in a step and is computed afresh.
+const REUSE_DISTANCE: Real = 1e-3;
+const REUSE_ANGLE: Real = 1e-4;
+
+/// Shapes whose pair yields at most one manifold with fixed sub-shapes (0, 0), so that a
+/// reused manifold stands for the whole pair.
+fn reusable(shape: &crate::shape::Shape) -> bool {
+    use crate::shape::Shape as S;
+    matches!(
+        shape,
+        S::Sphere { .. }
+            | S::Box { .. }
+            | S::Capsule { .. }
+            | S::Cylinder { .. }
+            | S::ConvexHull(_)
+    )
 }
 
 impl Contact {
@@ -116,6 +188,25 @@ impl ContactCache {
                 keep_previous(&old, ids[a], ids[b], a, b, &mut self.contacts);
                 continue;
             }
+            let (pa, pb) = (body_a.pose(), body_b.pose());
+            if reusable(&body_a.shape) && reusable(&body_b.shape) {
+                let relative = pa.inverse().mul(&pb);
+                if let Some(c) = old
+                    .find((ids[a], ids[b], 0, 0))
+                    .filter(|c| c.basis.holds(&relative, REUSE_DISTANCE * margin))
+                {
+                    let mut contact = Contact {
+                        index_a: a as u32,
+                        index_b: b as u32,
+                        ..*c
+                    };
+                    contact.basis.place(&mut contact.manifold, &pa, &pb);
+                    // Matches each point to itself, but re-anchors the ones that slid.
+                    warm_start(&mut contact, &old, (&pa, &pb));
+                    self.contacts.push(contact);
+                    continue;
+                }
+            }
             self.manifolds.clear();
             collide(
                 &body_a.shape,
@@ -138,9 +229,10 @@ impl ContactCache {
                     manifold: *manifold,
                     index_a: a as u32,
                     index_b: b as u32,
+                    basis: Basis::of(manifold, &pa, &pb),
                 });
                 let contact = self.contacts.last_mut().expect("just pushed");
-                warm_start(contact, &old, (&body_a.pose(), &body_b.pose()));
+                warm_start(contact, &old, (&pa, &pb));
             }
         }
         self.find_events();
@@ -279,18 +371,26 @@ impl Sorted<'_> {
 
     /// The contact with exactly this key.
     fn find(&self, key: (BodyId, BodyId, u32, u32)) -> Option<&Contact> {
+        // The first entry with the key, as the search below would return. The entry
+        // just found is tried too: a pair is looked up again after the reuse test.
+        let first = |h: usize| {
+            h < self.order.len()
+                && self.at(h).key() == key
+                && (h == 0 || self.at(h - 1).key() < key)
+        };
         let h = self.hint.get();
-        // The first entry with the key, as the search below would return.
-        if h < self.order.len() && self.at(h).key() == key && (h == 0 || self.at(h - 1).key() < key)
-        {
-            self.hint.set(h + 1);
-            return Some(self.at(h));
+        for h in [h, h.wrapping_sub(1)] {
+            if first(h) {
+                self.hint.set(h + 1);
+                return Some(self.at(h));
+            }
         }
         let k = self
             .order
             .partition_point(|&i| self.list[i as usize].key() < key);
-        self.hint.set(k + 1);
-        (k < self.order.len() && self.at(k).key() == key).then(|| self.at(k))
+        let found = k < self.order.len() && self.at(k).key() == key;
+        self.hint.set(if found { k + 1 } else { k });
+        found.then(|| self.at(k))
     }
 
     /// Every contact between the two bodies, in key order.
