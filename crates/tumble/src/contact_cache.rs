@@ -36,6 +36,14 @@ pub(crate) struct Basis {
 }
 
 impl Basis {
+    /// B's pose in A's frame, unnormalised: only compared, never applied.
+    fn relative(pa: &Pose, pb: &Pose) -> Pose {
+        Pose {
+            position: pa.inverse_transform_point(pb.position),
+            rotation: pa.rotation.inverse() * pb.rotation,
+        }
+    }
+
     fn of(m: &Manifold, pa: &Pose, pb: &Pose) -> Basis {
         let mut points = [(Vec3::ZERO, Vec3::ZERO); MAX_MANIFOLD_POINTS];
         for (l, p) in points.iter_mut().zip(m.points()) {
@@ -45,7 +53,7 @@ impl Basis {
             );
         }
         Basis {
-            relative: pa.inverse().mul(pb),
+            relative: Basis::relative(pa, pb),
             normal: pa.inverse_transform_vector(m.normal),
             points,
         }
@@ -190,11 +198,10 @@ impl ContactCache {
             }
             let (pa, pb) = (body_a.pose(), body_b.pose());
             if reusable(&body_a.shape) && reusable(&body_b.shape) {
-                let relative = pa.inverse().mul(&pb);
-                if let Some(c) = old
-                    .find((ids[a], ids[b], 0, 0))
-                    .filter(|c| c.basis.holds(&relative, REUSE_DISTANCE * margin))
-                {
+                if let Some(c) = old.find((ids[a], ids[b], 0, 0)).filter(|c| {
+                    c.basis
+                        .holds(&Basis::relative(&pa, &pb), REUSE_DISTANCE * margin)
+                }) {
                     let mut contact = Contact {
                         index_a: a as u32,
                         index_b: b as u32,
@@ -359,8 +366,7 @@ fn drop_covered_points(
 struct Sorted<'a> {
     list: &'a [Contact],
     order: &'a [u32],
-    /// Where the last `find` ended: the broad phase lists pairs in the same order every
-    /// step, so the next key is usually the next entry and the binary search is skipped.
+    /// Where the last `find` ended (see [`Sorted::first_not_below`]).
     hint: std::cell::Cell<usize>,
 }
 
@@ -371,26 +377,28 @@ impl Sorted<'_> {
 
     /// The contact with exactly this key.
     fn find(&self, key: (BodyId, BodyId, u32, u32)) -> Option<&Contact> {
-        // The first entry with the key, as the search below would return. The entry
-        // just found is tried too: a pair is looked up again after the reuse test.
-        let first = |h: usize| {
-            h < self.order.len()
-                && self.at(h).key() == key
-                && (h == 0 || self.at(h - 1).key() < key)
-        };
-        let h = self.hint.get();
-        for h in [h, h.wrapping_sub(1)] {
-            if first(h) {
-                self.hint.set(h + 1);
-                return Some(self.at(h));
+        let k = self.first_not_below(key);
+        self.hint.set(k);
+        (k < self.order.len() && self.at(k).key() == key).then(|| self.at(k))
+    }
+
+    /// The first position whose key is not below `key` (a partition point). Lookups come
+    /// in key order (the broad phase lists pairs sorted, and contacts were made in that
+    /// order), so it is usually a few steps on from the last one's; a binary search
+    /// otherwise.
+    fn first_not_below(&self, key: (BodyId, BodyId, u32, u32)) -> usize {
+        let len = self.order.len();
+        let mut k = self.hint.get().min(len);
+        if k == 0 || self.at(k - 1).key() < key {
+            for _ in 0..8 {
+                if k == len || self.at(k).key() >= key {
+                    return k;
+                }
+                k += 1;
             }
         }
-        let k = self
-            .order
-            .partition_point(|&i| self.list[i as usize].key() < key);
-        let found = k < self.order.len() && self.at(k).key() == key;
-        self.hint.set(if found { k + 1 } else { k });
-        found.then(|| self.at(k))
+        self.order
+            .partition_point(|&i| self.list[i as usize].key() < key)
     }
 
     /// Every contact between the two bodies, in key order.
