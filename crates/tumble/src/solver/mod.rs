@@ -142,7 +142,7 @@ impl Solver {
         }
         self.start_states.clone_from(&self.states);
         let rule = bias_rule(input.settings, input.scales, h);
-        self.prepare(bodies, contacts);
+        self.prepare(contacts);
         for i in 0..substeps {
             self.kick(input.system, input.time + i as Real * h, h);
             for c in &self.constraints {
@@ -194,17 +194,18 @@ impl Solver {
         }
     }
 
-    fn prepare(&mut self, bodies: &[Body], contacts: &[Contact]) {
+    fn prepare(&mut self, contacts: &[Contact]) {
         self.constraints.clear();
         self.points.clear();
         for i in self.colour_order(contacts) {
             let c = &contacts[i];
             let (a, b) = (c.index_a as usize, c.index_b as usize);
-            let friction = (bodies[a].friction * bodies[b].friction).sqrt();
-            let restitution = bodies[a].restitution.max(bodies[b].restitution);
+            let (sa, sb) = (&self.sims[a], &self.sims[b]);
+            let friction = (sa.friction * sb.friction).sqrt();
+            let restitution = sa.restitution.max(sb.restitution);
             let pose = |k: usize| {
                 let s = &self.sims[k];
-                crate::geometry::Pose::new(s.x - s.q * bodies[k].local_center, s.q)
+                crate::geometry::Pose::new(s.x - s.q * s.local_center, s.q)
             };
             let pair = PairData {
                 bodies: (a, b),
