@@ -355,6 +355,7 @@ impl ContactConstraint {
         states: &mut [BodyState],
         rule: &BiasRule,
         bias: bool,
+        totals: bool,
     ) {
         let Some((a, b)) = pair(states, self.a, self.b) else {
             return;
@@ -395,6 +396,9 @@ impl ContactConstraint {
         let slip = bias.then(|| [slip(0), slip(1)]);
         for k in 0..count {
             self.solve_friction(&mut hot[order(k)], a, b, rule, slip);
+        }
+        if totals {
+            ContactConstraint::add_to_totals(hot, &mut points.cold[self.range()]);
         }
     }
 
@@ -629,8 +633,8 @@ impl ContactConstraint {
 
     /// Adds the substep's impulses to the step's totals (each substep applies the
     /// accumulated impulse in full: warm start plus corrections).
-    pub fn add_to_totals(points: &mut Points) {
-        for (p, c) in points.hot.iter().zip(&mut points.cold) {
+    pub fn add_to_totals(hot: &[Point], cold: &mut [PointCold]) {
+        for (p, c) in hot.iter().zip(cold) {
             c.total_normal += p.normal_impulse;
             c.total_tangent[0] += p.tangent_impulse[0];
             c.total_tangent[1] += p.tangent_impulse[1];

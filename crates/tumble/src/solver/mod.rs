@@ -148,20 +148,29 @@ impl Solver {
             for c in &self.constraints {
                 c.warm_start(&self.points.hot, &mut self.states);
             }
-            for _ in 0..input.settings.iterations {
+            // The substep's impulses are final once the last pass has visited a
+            // manifold, so that pass adds them to the step's totals on its way instead
+            // of a separate walk over every point.
+            let iterations = input.settings.iterations;
+            let relax = input.settings.kind == SolverKind::SoftStep && iterations > 0;
+            for k in 0..iterations {
+                let totals = !relax && k + 1 == iterations;
                 for c in &self.constraints {
-                    c.solve(&mut self.points, &mut self.states, &rule, true);
+                    c.solve(&mut self.points, &mut self.states, &rule, true, totals);
                 }
             }
             self.drift(bodies, h);
-            if input.settings.kind == SolverKind::SoftStep {
-                for _ in 0..input.settings.iterations {
+            if relax {
+                for k in 0..iterations {
+                    let totals = k + 1 == iterations;
                     for c in &self.constraints {
-                        c.solve(&mut self.points, &mut self.states, &rule, false);
+                        c.solve(&mut self.points, &mut self.states, &rule, false, totals);
                     }
                 }
             }
-            ContactConstraint::add_to_totals(&mut self.points);
+            if iterations == 0 {
+                ContactConstraint::add_to_totals(&self.points.hot, &mut self.points.cold);
+            }
         }
         self.moving.clear();
         self.moving.extend(self.sims.iter().map(|s| s.moves));
