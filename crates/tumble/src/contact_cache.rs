@@ -212,15 +212,14 @@ impl ContactCache {
                     c.basis
                         .holds(&Basis::relative(&pa, &pb), REUSE_DISTANCE * margin)
                 }) {
-                    let mut contact = Contact {
-                        index_a: a as u32,
-                        index_b: b as u32,
-                        ..*c
-                    };
+                    // Updated in place: a contact is a kilobyte, and a copy on the stack
+                    // before the push doubled what this costs.
+                    self.contacts.push(*c);
+                    let contact = self.contacts.last_mut().expect("just pushed");
+                    (contact.index_a, contact.index_b) = (a as u32, b as u32);
                     contact.basis.place(&mut contact.manifold, &pa, &pb);
                     // Matches each point to itself, but re-anchors the ones that slid.
-                    warm_start(&mut contact, &old, (&pa, &pb));
-                    self.contacts.push(contact);
+                    warm_start(contact, &old, (&pa, &pb));
                     continue;
                 }
             }
