@@ -183,6 +183,9 @@ pub(crate) struct ContactConstraint {
     restitution: Real,
     first: usize,
     count: usize,
+    /// Graph colour (see `Solver::colour_order`): constraints of one colour below 63
+    /// share no moving body.
+    colour: u32,
 }
 
 /// The friction impulse in the tangent plane: the impulse `want` that would stop the
@@ -239,7 +242,7 @@ impl ContactConstraint {
     /// Anchors, Jacobians, effective masses and the warm-start impulses of a manifold;
     /// its points are appended to `points`.
     pub fn prepare(
-        index: usize,
+        (index, colour): (usize, u32),
         contact: &Contact,
         pair: &PairData,
         (sims, states): (&[BodySim], &[BodyState]),
@@ -267,6 +270,7 @@ impl ContactConstraint {
             restitution,
             first: points.hot.len(),
             count: m.len(),
+            colour,
         };
         for mp in m.points() {
             let mid = (mp.point_a + mp.point_b) * 0.5;
@@ -366,15 +370,7 @@ impl ContactConstraint {
         // opposite order, so the bias of one pass cancels that of the other.
         let count = self.count;
         let order = move |k: usize| if bias { k } else { count - 1 - k };
-        // Current separation of a point: s₀ + n·(Δp_b + ΔR_b r_b − r_b − Δp_a − ΔR_a r_a + r_a)
-        // = s₀ + n·(Δp_b − Δp_a) + (ΔR_bᵀn)·r_b − (ΔR_aᵀn)·r_a − n·(r_b − r_a); the first
-        // three factors are shared by the manifold's points.
-        let n = self.normal;
-        let moved = (
-            n.dot(b.dp - a.dp),
-            a.dr.transpose() * n,
-            b.dr.transpose() * n,
-        );
+        let moved = self.moved(a, b);
         for k in 0..count {
             let i = order(k);
             if let Some(vn) = self.solve_normal(&mut hot[i], a, b, rule, bias, moved) {
@@ -384,16 +380,7 @@ impl ContactConstraint {
                 cold.approach_velocity = cold.approach_velocity.min(vn);
             }
         }
-        // The anchors' gap along each tangent moves like the separation along n.
-        let t = self.tangents;
-        let slip = |k: usize| {
-            (
-                t[k].dot(b.dp - a.dp),
-                a.dr.transpose() * t[k],
-                b.dr.transpose() * t[k],
-            )
-        };
-        let slip = bias.then(|| [slip(0), slip(1)]);
+        let slip = bias.then(|| self.slip(a, b));
         for k in 0..count {
             self.solve_friction(&mut hot[order(k)], a, b, rule, slip);
         }
@@ -402,9 +389,103 @@ impl ContactConstraint {
         }
     }
 
+    /// Whether `self` and the next constraint `next` may be solved together: same colour,
+    /// so no moving body in common (colour 63 collects the overflow and guarantees nothing),
+    /// and no static one either (the borrows must be disjoint).
+    pub fn pairs_with(&self, next: &ContactConstraint) -> bool {
+        self.colour == next.colour
+            && self.colour < 63
+            && next.first == self.first + self.count
+            && ![self.a, self.b].contains(&next.a)
+            && ![self.a, self.b].contains(&next.b)
+    }
+
+    /// [`Self::solve`] for `self` and `next` (see [`Self::pairs_with`]), point by point in
+    /// turn. A pass is a chain of dependent updates through each manifold's two bodies;
+    /// two chains on disjoint bodies let the processor work on both at once. Every update
+    /// is the one the two separate passes would make, so results are bit-identical.
+    pub fn solve_two(
+        &self,
+        next: &ContactConstraint,
+        points: &mut Points,
+        states: &mut [BodyState],
+        (rule, bias, totals): (&BiasRule, bool, bool),
+    ) {
+        let Ok([a1, b1, a2, b2]) = states.get_disjoint_mut([self.a, self.b, next.a, next.b]) else {
+            self.solve(points, states, rule, bias, totals);
+            next.solve(points, states, rule, bias, totals);
+            return;
+        };
+        let span = self.first..next.first + next.count;
+        let (h1, h2) = points.hot[span.clone()].split_at_mut(self.count);
+        let cold = &mut points.cold[span];
+        let (m1, m2) = (self.moved(a1, b1), next.moved(a2, b2));
+        let order = |c: &ContactConstraint, k: usize| if bias { k } else { c.count - 1 - k };
+        for k in 0..self.count.max(next.count) {
+            if k < self.count {
+                let i = order(self, k);
+                if let Some(vn) = self.solve_normal(&mut h1[i], a1, b1, rule, bias, m1) {
+                    let c = &mut cold[i];
+                    c.approach_velocity = c.approach_velocity.min(vn);
+                }
+            }
+            if k < next.count {
+                let i = order(next, k);
+                if let Some(vn) = next.solve_normal(&mut h2[i], a2, b2, rule, bias, m2) {
+                    let c = &mut cold[self.count + i];
+                    c.approach_velocity = c.approach_velocity.min(vn);
+                }
+            }
+        }
+        let (s1, s2) = (
+            bias.then(|| self.slip(a1, b1)),
+            bias.then(|| next.slip(a2, b2)),
+        );
+        for k in 0..self.count.max(next.count) {
+            if k < self.count {
+                self.solve_friction(&mut h1[order(self, k)], a1, b1, rule, s1);
+            }
+            if k < next.count {
+                next.solve_friction(&mut h2[order(next, k)], a2, b2, rule, s2);
+            }
+        }
+        if totals {
+            let (c1, c2) = cold.split_at_mut(self.count);
+            ContactConstraint::add_to_totals(h1, c1);
+            ContactConstraint::add_to_totals(h2, c2);
+        }
+    }
+
+    /// Current separation of a point: s₀ + n·(Δp_b + ΔR_b r_b − r_b − Δp_a − ΔR_a r_a + r_a)
+    /// = s₀ + n·(Δp_b − Δp_a) + (ΔR_bᵀn)·r_b − (ΔR_aᵀn)·r_a − n·(r_b − r_a); the first
+    /// three factors are shared by the manifold's points.
+    #[inline(always)]
+    fn moved(&self, a: &BodyState, b: &BodyState) -> (Real, Vec3, Vec3) {
+        let n = self.normal;
+        (
+            n.dot(b.dp - a.dp),
+            a.dr.transpose() * n,
+            b.dr.transpose() * n,
+        )
+    }
+
+    /// The anchors' gap along each tangent moves like the separation along n.
+    #[inline(always)]
+    fn slip(&self, a: &BodyState, b: &BodyState) -> [(Real, Vec3, Vec3); 2] {
+        let t = self.tangents;
+        let slip = |k: usize| {
+            (
+                t[k].dot(b.dp - a.dp),
+                a.dr.transpose() * t[k],
+                b.dr.transpose() * t[k],
+            )
+        };
+        [slip(0), slip(1)]
+    }
+
     /// The normal row at one point; at the moment of impact (the first push of the step)
     /// it returns the normal velocity met, for the caller to record as the approach.
-    #[inline]
+    #[inline(always)]
     fn solve_normal(
         &self,
         p: &mut Point,
@@ -446,7 +527,7 @@ impl ContactConstraint {
     /// back towards its anchors by the contact's soft spring, so that the slow creep a
     /// velocity-only friction leaves (a pile spreading by millimetres) is undone; the
     /// spring cannot exceed the cone, so it never holds a body that should slide.
-    #[inline]
+    #[inline(always)]
     fn solve_friction(
         &self,
         p: &mut Point,

@@ -155,17 +155,13 @@ impl Solver {
             let relax = input.settings.kind == SolverKind::SoftStep && iterations > 0;
             for k in 0..iterations {
                 let totals = !relax && k + 1 == iterations;
-                for c in &self.constraints {
-                    c.solve(&mut self.points, &mut self.states, &rule, true, totals);
-                }
+                self.solve_pass(&rule, true, totals);
             }
             self.drift(bodies, h);
             if relax {
                 for k in 0..iterations {
                     let totals = k + 1 == iterations;
-                    for c in &self.constraints {
-                        c.solve(&mut self.points, &mut self.states, &rule, false, totals);
-                    }
+                    self.solve_pass(&rule, false, totals);
                 }
             }
             if iterations == 0 {
@@ -206,7 +202,7 @@ impl Solver {
     fn prepare(&mut self, contacts: &[Contact]) {
         self.constraints.clear();
         self.points.clear();
-        for i in self.colour_order(contacts) {
+        for (colour, i) in self.colour_order(contacts) {
             let c = &contacts[i];
             let (a, b) = (c.index_a as usize, c.index_b as usize);
             let (sa, sb) = (&self.sims[a], &self.sims[b]);
@@ -222,7 +218,7 @@ impl Solver {
                 poses: (pose(a), pose(b)),
             };
             self.constraints.push(ContactConstraint::prepare(
-                i,
+                (i, colour),
                 c,
                 &pair,
                 (&self.sims, &self.states),
@@ -235,7 +231,7 @@ impl Solver {
     /// body (greedy graph colouring, colour by colour). Gauss–Seidel passes are a chain of
     /// dependent updates; constraints on disjoint bodies let the processor overlap them.
     /// Deterministic: colours depend only on the contacts' order, itself deterministic.
-    fn colour_order(&self, contacts: &[Contact]) -> Vec<usize> {
+    fn colour_order(&self, contacts: &[Contact]) -> Vec<(u32, usize)> {
         let mut used = vec![0u64; self.sims.len()];
         let mut coloured = Vec::with_capacity(contacts.len());
         for (i, c) in contacts.iter().enumerate() {
@@ -253,7 +249,27 @@ impl Solver {
             coloured.push((colour, i));
         }
         coloured.sort_unstable();
-        coloured.into_iter().map(|(_, i)| i).collect()
+        coloured
+    }
+
+    /// One pass over every constraint, in colour order; neighbours of one colour are
+    /// solved two at a time (see `ContactConstraint::solve_two`).
+    fn solve_pass(&mut self, rule: &BiasRule, bias: bool, totals: bool) {
+        let cs = &self.constraints;
+        let mut i = 0;
+        while i < cs.len() {
+            match cs.get(i + 1).filter(|next| cs[i].pairs_with(next)) {
+                Some(next) => {
+                    let pass = (rule, bias, totals);
+                    cs[i].solve_two(next, &mut self.points, &mut self.states, pass);
+                    i += 2;
+                }
+                None => {
+                    cs[i].solve(&mut self.points, &mut self.states, rule, bias, totals);
+                    i += 1;
+                }
+            }
+        }
     }
 
     /// v += h F/m, L += h N for the solved bodies, forces taken at the current substep.
