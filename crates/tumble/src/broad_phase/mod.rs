@@ -340,6 +340,14 @@ impl BroadPhase {
         }
     }
 
+    /// Calls `f(user)` for every static proxy whose box overlaps `aabb`: the moving tree,
+    /// which holds nearly every proxy, is not walked.
+    pub fn query_static_aabb(&self, aabb: &Aabb, mut f: impl FnMut(u32)) {
+        let mut stack = Vec::new();
+        self.trees[tree_index(ProxyKind::Static)]
+            .query(aabb, &mut stack, |id| f(self.proxies[id as usize].user));
+    }
+
     /// Calls `f(user)` for every proxy whose enlarged box overlaps `aabb` (static proxies
     /// first).
     pub fn query_aabb(&self, aabb: &Aabb, mut f: impl FnMut(u32)) {

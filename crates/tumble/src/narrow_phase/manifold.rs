@@ -176,17 +176,34 @@ pub fn reduce(candidates: &[Candidate], margin: Real, out: &mut Manifold) {
     // hair apart; which twin the selection below keeps would flip from step to step and
     // take the warm start with it. Twins closer than a quarter of the margin are one point.
     let twin = 0.25 * margin;
-    let mut kept: Vec<&Candidate> = Vec::with_capacity(candidates.len());
+    let Some(first) = candidates.first() else {
+        return;
+    };
+    // On the stack for the usual handful of candidates: a heap list per pair and step
+    // showed in profiles.
+    let mut stack = [first; 16];
+    let mut heap = Vec::new();
+    let store: &mut [&Candidate] = if candidates.len() <= stack.len() {
+        &mut stack
+    } else {
+        heap.resize(candidates.len(), first);
+        &mut heap
+    };
+    let mut len = 0;
     for c in candidates.iter().filter(|c| sep(c) <= margin) {
-        match kept
+        match store[..len]
             .iter_mut()
             .find(|k| (k.point_a - c.point_a).length_squared() < twin * twin)
         {
             Some(k) if sep(c) < sep(k) => *k = c,
             Some(_) => {}
-            None => kept.push(c),
+            None => {
+                store[len] = c;
+                len += 1;
+            }
         }
     }
+    let kept = &store[..len];
     if kept.len() <= MAX_MANIFOLD_POINTS {
         for c in kept {
             out.push(c.point_a, c.point_b, c.feature);

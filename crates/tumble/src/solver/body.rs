@@ -37,6 +37,12 @@ pub(crate) struct BodySim {
     pub inv_inertia: Mat3,
     /// True for awake dynamic bodies the solver moves.
     pub moves: bool,
+    /// The body's friction and restitution coefficients and centre of mass in its frame,
+    /// copied here so that preparing contacts, which visits bodies in no particular
+    /// order, does not fetch each one's whole `Body`.
+    pub friction: Real,
+    pub restitution: Real,
+    pub local_center: Vec3,
 }
 
 impl BodySim {
@@ -73,6 +79,9 @@ impl BodySim {
             inertia,
             inv_inertia,
             moves,
+            friction: body.friction,
+            restitution: body.restitution,
+            local_center: body.local_center,
         };
         let state = BodyState {
             v: m.v,

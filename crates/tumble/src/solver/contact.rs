@@ -18,7 +18,6 @@ use super::softness::Softness;
 use crate::contact_cache::Contact;
 use crate::geometry::Pose;
 use crate::math::{Real, Vec3};
-use crate::narrow_phase::MAX_MANIFOLD_POINTS;
 
 /// How position error turns into velocity in one substep.
 #[derive(Debug, Clone, Copy)]
@@ -41,12 +40,11 @@ pub(crate) struct BiasRule {
     pub slip_speed: Real,
 }
 
-/// One Jacobian row at one point: angular parts and their images under I⁻¹.
+/// One Jacobian row at one point: the images under I⁻¹ of its angular parts, and its
+/// effective mass. The angular parts r × d themselves are recomputed where needed: two
+/// cross products cost less than streaming 48 more bytes per row through every pass.
 #[derive(Debug, Clone, Copy, Default)]
 struct Row {
-    /// r_a × d and r_b × d.
-    ang_a: Vec3,
-    ang_b: Vec3,
     /// I_a⁻¹ (r_a × d) and I_b⁻¹ (r_b × d): the change of ω per unit impulse.
     turn_a: Vec3,
     turn_b: Vec3,
@@ -58,18 +56,16 @@ impl Row {
         let k = a.inverse_mass_along(d, ra) + b.inverse_mass_along(d, rb);
         let (ang_a, ang_b) = (ra.cross(d), rb.cross(d));
         Row {
-            ang_a,
-            ang_b,
             turn_a: a.inv_inertia * ang_a,
             turn_b: b.inv_inertia * ang_b,
             mass: if k > 0.0 { 1.0 / k } else { 0.0 },
         }
     }
 
-    /// Relative velocity along the row's direction `d`.
+    /// Relative velocity along the row's direction `d`, at anchors `r` = (r_a, r_b).
     #[inline]
-    fn velocity(&self, d: Vec3, a: &BodyState, b: &BodyState) -> Real {
-        d.dot(b.v - a.v) + self.ang_b.dot(b.w) - self.ang_a.dot(a.w)
+    fn velocity(&self, d: Vec3, r: (Vec3, Vec3), a: &BodyState, b: &BodyState) -> Real {
+        d.dot(b.v - a.v) + r.1.cross(d).dot(b.w) - r.0.cross(d).dot(a.w)
     }
 
     /// Applies impulse `lambda` along the row; `push_a`, `push_b` are M⁻¹d of each body,
@@ -96,8 +92,11 @@ impl Row {
     }
 }
 
+/// What the solver passes read and write at a contact point; the rest lives in
+/// [`PointCold`]. Kept apart and packed in one list for all manifolds, so that a pass
+/// streams only the bytes it uses: a pile's points overflow the L2 cache otherwise.
 #[derive(Debug, Clone, Copy, Default)]
-struct Point {
+pub(crate) struct Point {
     /// Anchors from each centre of mass, world frame, at the start of the step.
     ra: Vec3,
     rb: Vec3,
@@ -112,6 +111,16 @@ struct Point {
     tangent_impulse: [Real; 2],
     /// Largest normal impulse of the step: restitution only acts where contact pushed.
     max_normal_impulse: Real,
+    /// Friction anchors: how far apart, along each tangent, the two material points that
+    /// touched when the contact began were at the step's start (zero for a new point).
+    anchor_gap: [Real; 2],
+    /// t · (r_b − r_a) per tangent, for the anchors' current gap (as `lever` for the normal).
+    tangent_lever: [Real; 2],
+}
+
+/// A contact point's data that the solve passes seldom touch: bounces and reports.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct PointCold {
     /// Normal velocity before the step, lowered to the velocity at the moment of impact
     /// if the step's gravity sped the approach up: the speed restitution reflects.
     approach_velocity: Real,
@@ -129,11 +138,20 @@ struct Point {
     /// Impulses summed over the step's substeps (for reporting).
     total_normal: Real,
     total_tangent: [Real; 2],
-    /// Friction anchors: how far apart, along each tangent, the two material points that
-    /// touched when the contact began were at the step's start (zero for a new point).
-    anchor_gap: [Real; 2],
-    /// t · (r_b − r_a) per tangent, for the anchors' current gap (as `lever` for the normal).
-    tangent_lever: [Real; 2],
+}
+
+/// Every contact point of the step, manifold by manifold, hot and cold parts in step.
+#[derive(Debug, Default)]
+pub(crate) struct Points {
+    pub hot: Vec<Point>,
+    pub cold: Vec<PointCold>,
+}
+
+impl Points {
+    pub fn clear(&mut self) {
+        self.hot.clear();
+        self.cold.clear();
+    }
 }
 
 /// What the solver knows of a contact's two bodies when it prepares the constraint.
@@ -146,7 +164,8 @@ pub(crate) struct PairData {
     pub poses: (Pose, Pose),
 }
 
-/// One manifold as the solver works on it.
+/// One manifold as the solver works on it; its points are `count` entries of [`Points`]
+/// from `first`.
 #[derive(Debug, Clone)]
 pub(crate) struct ContactConstraint {
     a: usize,
@@ -162,8 +181,11 @@ pub(crate) struct ContactConstraint {
     moves: (bool, bool),
     friction: Real,
     restitution: Real,
-    points: [Point; MAX_MANIFOLD_POINTS],
+    first: usize,
     count: usize,
+    /// Graph colour (see `Solver::colour_order`): constraints of one colour below 63
+    /// share no moving body.
+    colour: u32,
 }
 
 /// The friction impulse in the tangent plane: the impulse `want` that would stop the
@@ -217,13 +239,14 @@ fn pair(states: &mut [BodyState], a: usize, b: usize) -> Option<(&mut BodyState,
 }
 
 impl ContactConstraint {
-    /// Anchors, Jacobians, effective masses and the warm-start impulses of a manifold.
+    /// Anchors, Jacobians, effective masses and the warm-start impulses of a manifold;
+    /// its points are appended to `points`.
     pub fn prepare(
-        index: usize,
+        (index, colour): (usize, u32),
         contact: &Contact,
         pair: &PairData,
-        sims: &[BodySim],
-        states: &[BodyState],
+        (sims, states): (&[BodySim], &[BodyState]),
+        points: &mut Points,
     ) -> Self {
         let (a, b) = pair.bodies;
         let (friction, restitution) = pair.material;
@@ -233,25 +256,27 @@ impl ContactConstraint {
         let normal = m.normal;
         let tangents = tangent_basis(normal);
         let dirs = [normal, tangents[0], tangents[1]];
-        let mut c = ContactConstraint {
+        let push = |s: &BodySim, k: usize| s.linear_mask * dirs[k] * s.inv_mass;
+        let c = ContactConstraint {
             a,
             b,
             contact: index,
             normal,
             tangents,
-            push_a: dirs.map(|d| sa.linear_mask * d * sa.inv_mass),
-            push_b: dirs.map(|d| sb.linear_mask * d * sb.inv_mass),
+            push_a: [push(sa, 0), push(sa, 1), push(sa, 2)],
+            push_b: [push(sb, 0), push(sb, 1), push(sb, 2)],
             moves: (sa.moves, sb.moves),
             friction,
             restitution,
-            points: [Point::default(); MAX_MANIFOLD_POINTS],
+            first: points.hot.len(),
             count: m.len(),
+            colour,
         };
-        for (p, mp) in c.points.iter_mut().zip(m.points()) {
+        for mp in m.points() {
             let mid = (mp.point_a + mp.point_b) * 0.5;
             let (ra, rb) = (mid - sa.x, mid - sb.x);
             let normal_row = Row::new(normal, ra, rb, sa, sb);
-            *p = Point {
+            points.hot.push(Point {
                 ra,
                 rb,
                 separation: mp.separation,
@@ -266,16 +291,6 @@ impl ContactConstraint {
                 // still point the same way.
                 tangent_impulse: mp.tangent_impulse,
                 max_normal_impulse: 0.0,
-                approach_velocity: normal_row.velocity(normal, &states[a], &states[b]),
-                start_velocity: normal_row.velocity(normal, &states[a], &states[b]),
-                replay_approach: 0.0,
-                replay_target: 0.0,
-                replay_impulse: 0.0,
-                replay_bounced: false,
-                bounce_target: None,
-                bounce_impulse: 0.0,
-                total_normal: 0.0,
-                total_tangent: [0.0; 2],
                 anchor_gap: if mp.anchored {
                     let gap =
                         poses.1.transform_point(mp.anchor_b) - poses.0.transform_point(mp.anchor_a);
@@ -284,7 +299,13 @@ impl ContactConstraint {
                     [0.0; 2]
                 },
                 tangent_lever: [tangents[0].dot(rb - ra), tangents[1].dot(rb - ra)],
-            };
+            });
+            let start_velocity = normal_row.velocity(normal, (ra, rb), &states[a], &states[b]);
+            points.cold.push(PointCold {
+                approach_velocity: start_velocity,
+                start_velocity,
+                ..PointCold::default()
+            });
         }
         c
     }
@@ -294,12 +315,16 @@ impl ContactConstraint {
         (self.a, self.b)
     }
 
+    fn range(&self) -> std::ops::Range<usize> {
+        self.first..self.first + self.count
+    }
+
     /// Applies the accumulated impulses again (each substep, as Box2D v3 does).
-    pub fn warm_start(&self, states: &mut [BodyState]) {
+    pub fn warm_start(&self, points: &[Point], states: &mut [BodyState]) {
         let Some((a, b)) = pair(states, self.a, self.b) else {
             return;
         };
-        for p in &self.points[..self.count] {
+        for p in &points[self.range()] {
             p.normal.apply(
                 p.normal_impulse,
                 (self.push_a[0], self.push_b[0]),
@@ -328,54 +353,149 @@ impl ContactConstraint {
     /// (or, for PGS, by Baumgarte); without, only velocities are made consistent (relax).
     /// Positive separations are speculative: the bodies may close the gap this substep,
     /// not more.
-    pub fn solve(&mut self, states: &mut [BodyState], rule: &BiasRule, bias: bool) {
+    pub fn solve(
+        &self,
+        points: &mut Points,
+        states: &mut [BodyState],
+        rule: &BiasRule,
+        bias: bool,
+        totals: bool,
+    ) {
         let Some((a, b)) = pair(states, self.a, self.b) else {
             return;
         };
+        let hot = &mut points.hot[self.range()];
         // Gauss–Seidel favours the point solved first; a symmetric stack would lean the
         // same way every pass and sway. The relax pass therefore walks the points in the
         // opposite order, so the bias of one pass cancels that of the other.
         let count = self.count;
         let order = move |k: usize| if bias { k } else { count - 1 - k };
-        // Current separation of a point: s₀ + n·(Δp_b + ΔR_b r_b − r_b − Δp_a − ΔR_a r_a + r_a)
-        // = s₀ + n·(Δp_b − Δp_a) + (ΔR_bᵀn)·r_b − (ΔR_aᵀn)·r_a − n·(r_b − r_a); the first
-        // three factors are shared by the manifold's points.
-        let n = self.normal;
-        let moved = (
-            n.dot(b.dp - a.dp),
-            a.dr.transpose() * n,
-            b.dr.transpose() * n,
-        );
+        let moved = self.moved(a, b);
         for k in 0..count {
-            self.solve_normal(order(k), a, b, rule, bias, moved);
+            let i = order(k);
+            if let Some(vn) = self.solve_normal(&mut hot[i], a, b, rule, bias, moved) {
+                // The moment of impact: the velocity to reflect is this one, gravity of
+                // the substeps so far included, not the one at the start of the step.
+                let cold = &mut points.cold[self.first + i];
+                cold.approach_velocity = cold.approach_velocity.min(vn);
+            }
         }
-        // The anchors' gap along each tangent moves like the separation along n.
-        let t = self.tangents;
-        let slip = bias.then(|| {
-            [0, 1].map(|k| {
-                (
-                    t[k].dot(b.dp - a.dp),
-                    a.dr.transpose() * t[k],
-                    b.dr.transpose() * t[k],
-                )
-            })
-        });
+        let slip = bias.then(|| self.slip(a, b));
         for k in 0..count {
-            self.solve_friction(order(k), a, b, rule, slip);
+            self.solve_friction(&mut hot[order(k)], a, b, rule, slip);
+        }
+        if totals {
+            ContactConstraint::add_to_totals(hot, &mut points.cold[self.range()]);
         }
     }
 
+    /// Whether `self` and the next constraint `next` may be solved together: same colour,
+    /// so no moving body in common (colour 63 collects the overflow and guarantees nothing),
+    /// and no static one either (the borrows must be disjoint).
+    pub fn pairs_with(&self, next: &ContactConstraint) -> bool {
+        self.colour == next.colour
+            && self.colour < 63
+            && next.first == self.first + self.count
+            && ![self.a, self.b].contains(&next.a)
+            && ![self.a, self.b].contains(&next.b)
+    }
+
+    /// [`Self::solve`] for `self` and `next` (see [`Self::pairs_with`]), point by point in
+    /// turn. A pass is a chain of dependent updates through each manifold's two bodies;
+    /// two chains on disjoint bodies let the processor work on both at once. Every update
+    /// is the one the two separate passes would make, so results are bit-identical.
+    pub fn solve_two(
+        &self,
+        next: &ContactConstraint,
+        points: &mut Points,
+        states: &mut [BodyState],
+        (rule, bias, totals): (&BiasRule, bool, bool),
+    ) {
+        let Ok([a1, b1, a2, b2]) = states.get_disjoint_mut([self.a, self.b, next.a, next.b]) else {
+            self.solve(points, states, rule, bias, totals);
+            next.solve(points, states, rule, bias, totals);
+            return;
+        };
+        let span = self.first..next.first + next.count;
+        let (h1, h2) = points.hot[span.clone()].split_at_mut(self.count);
+        let cold = &mut points.cold[span];
+        let (m1, m2) = (self.moved(a1, b1), next.moved(a2, b2));
+        let order = |c: &ContactConstraint, k: usize| if bias { k } else { c.count - 1 - k };
+        for k in 0..self.count.max(next.count) {
+            if k < self.count {
+                let i = order(self, k);
+                if let Some(vn) = self.solve_normal(&mut h1[i], a1, b1, rule, bias, m1) {
+                    let c = &mut cold[i];
+                    c.approach_velocity = c.approach_velocity.min(vn);
+                }
+            }
+            if k < next.count {
+                let i = order(next, k);
+                if let Some(vn) = next.solve_normal(&mut h2[i], a2, b2, rule, bias, m2) {
+                    let c = &mut cold[self.count + i];
+                    c.approach_velocity = c.approach_velocity.min(vn);
+                }
+            }
+        }
+        let (s1, s2) = (
+            bias.then(|| self.slip(a1, b1)),
+            bias.then(|| next.slip(a2, b2)),
+        );
+        for k in 0..self.count.max(next.count) {
+            if k < self.count {
+                self.solve_friction(&mut h1[order(self, k)], a1, b1, rule, s1);
+            }
+            if k < next.count {
+                next.solve_friction(&mut h2[order(next, k)], a2, b2, rule, s2);
+            }
+        }
+        if totals {
+            let (c1, c2) = cold.split_at_mut(self.count);
+            ContactConstraint::add_to_totals(h1, c1);
+            ContactConstraint::add_to_totals(h2, c2);
+        }
+    }
+
+    /// Current separation of a point: s₀ + n·(Δp_b + ΔR_b r_b − r_b − Δp_a − ΔR_a r_a + r_a)
+    /// = s₀ + n·(Δp_b − Δp_a) + (ΔR_bᵀn)·r_b − (ΔR_aᵀn)·r_a − n·(r_b − r_a); the first
+    /// three factors are shared by the manifold's points.
+    #[inline(always)]
+    fn moved(&self, a: &BodyState, b: &BodyState) -> (Real, Vec3, Vec3) {
+        let n = self.normal;
+        (
+            n.dot(b.dp - a.dp),
+            a.dr.transpose() * n,
+            b.dr.transpose() * n,
+        )
+    }
+
+    /// The anchors' gap along each tangent moves like the separation along n.
+    #[inline(always)]
+    fn slip(&self, a: &BodyState, b: &BodyState) -> [(Real, Vec3, Vec3); 2] {
+        let t = self.tangents;
+        let slip = |k: usize| {
+            (
+                t[k].dot(b.dp - a.dp),
+                a.dr.transpose() * t[k],
+                b.dr.transpose() * t[k],
+            )
+        };
+        [slip(0), slip(1)]
+    }
+
+    /// The normal row at one point; at the moment of impact (the first push of the step)
+    /// it returns the normal velocity met, for the caller to record as the approach.
+    #[inline(always)]
     fn solve_normal(
-        &mut self,
-        i: usize,
+        &self,
+        p: &mut Point,
         a: &mut BodyState,
         b: &mut BodyState,
         rule: &BiasRule,
         bias: bool,
         moved: (Real, Vec3, Vec3),
-    ) {
+    ) -> Option<Real> {
         let n = self.normal;
-        let p = &mut self.points[i];
         let s = p.separation + moved.0 + moved.2.dot(p.rb) - moved.1.dot(p.ra) - p.lever;
         let (velocity_bias, mass_scale, impulse_scale) = if s > 0.0 {
             (s * rule.inv_h, 1.0, 0.0)
@@ -390,55 +510,57 @@ impl ContactConstraint {
         } else {
             (0.0, 1.0, 0.0)
         };
-        let vn = p.normal.velocity(n, a, b);
+        let vn = p.normal.velocity(n, (p.ra, p.rb), a, b);
         let delta =
             -p.normal.mass * mass_scale * (vn + velocity_bias) - impulse_scale * p.normal_impulse;
         let total = (p.normal_impulse + delta).max(0.0);
         let applied = total - p.normal_impulse;
-        if p.max_normal_impulse == 0.0 && applied > 0.0 {
-            // The moment of impact: the velocity to reflect is this one, gravity of
-            // the substeps so far included, not the one at the start of the step.
-            p.approach_velocity = p.approach_velocity.min(vn);
-        }
+        let impact = (p.max_normal_impulse == 0.0 && applied > 0.0).then_some(vn);
         p.normal_impulse = total;
         p.max_normal_impulse = p.max_normal_impulse.max(applied);
         p.normal
             .apply(applied, (self.push_a[0], self.push_b[0]), self.moves, a, b);
+        impact
     }
 
     /// Coulomb friction at one point. In the biased pass a sticking point is also pulled
     /// back towards its anchors by the contact's soft spring, so that the slow creep a
     /// velocity-only friction leaves (a pile spreading by millimetres) is undone; the
     /// spring cannot exceed the cone, so it never holds a body that should slide.
+    #[inline(always)]
     fn solve_friction(
-        &mut self,
-        i: usize,
+        &self,
+        p: &mut Point,
         a: &mut BodyState,
         b: &mut BodyState,
         rule: &BiasRule,
         slip: Option<[(Real, Vec3, Vec3); 2]>,
     ) {
         let soft = rule.softness;
-        let p = &mut self.points[i];
         if p.normal_impulse == 0.0 && p.tangent_impulse == [0.0; 2] {
             // A point that pushes nothing has a zero friction cone: nothing to do. Most
             // speculative points (neighbours side by side in a pile) are such.
             return;
         }
         let vt = [
-            p.tangent[0].velocity(self.tangents[0], a, b),
-            p.tangent[1].velocity(self.tangents[1], a, b),
+            p.tangent[0].velocity(self.tangents[0], (p.ra, p.rb), a, b),
+            p.tangent[1].velocity(self.tangents[1], (p.ra, p.rb), a, b),
         ];
         let want = match slip {
-            Some(moved) => [0, 1].map(|k| {
-                let (m, da, db) = moved[k];
-                let gap = p.anchor_gap[k] + m + db.dot(p.rb) - da.dot(p.ra) - p.tangent_lever[k];
-                let bias =
-                    (ANCHOR_STIFFNESS * soft.bias_rate * gap).clamp(-rule.max_push, rule.max_push);
-                p.tangent_impulse[k]
-                    - p.tangent[k].mass * soft.mass_scale * (vt[k] + bias)
-                    - soft.impulse_scale * p.tangent_impulse[k]
-            }),
+            Some(moved) => {
+                let want = |k: usize| {
+                    let (m, da, db) = moved[k];
+                    let gap =
+                        p.anchor_gap[k] + m + db.dot(p.rb) - da.dot(p.ra) - p.tangent_lever[k];
+                    let bias = (ANCHOR_STIFFNESS * soft.bias_rate * gap)
+                        .clamp(-rule.max_push, rule.max_push);
+                    p.tangent_impulse[k]
+                        - p.tangent[k].mass * soft.mass_scale * (vt[k] + bias)
+                        - soft.impulse_scale * p.tangent_impulse[k]
+                };
+                // Written out rather than `[0, 1].map`, which the compiler left as a call.
+                [want(0), want(1)]
+            }
             None => [
                 p.tangent_impulse[0] - p.tangent[0].mass * vt[0],
                 p.tangent_impulse[1] - p.tangent[1].mass * vt[1],
@@ -459,33 +581,45 @@ impl ContactConstraint {
 
     /// Whether a point of this manifold was pushed this step after approaching faster
     /// than `threshold`, with a restitution to reflect it: a bounce to resolve.
-    pub fn bounces(&self, threshold: Real) -> bool {
+    pub fn bounces(&self, points: &Points, threshold: Real) -> bool {
         self.restitution > 0.0
-            && self.points[..self.count]
+            && points.hot[self.range()]
                 .iter()
-                .any(|p| p.max_normal_impulse > 0.0 && p.approach_velocity < -threshold)
+                .zip(&points.cold[self.range()])
+                .any(|(p, c)| p.max_normal_impulse > 0.0 && c.approach_velocity < -threshold)
     }
 
     /// Whether any point pushed this step.
-    pub fn touched(&self) -> bool {
-        self.points[..self.count]
+    pub fn touched(&self, points: &Points) -> bool {
+        points.hot[self.range()]
             .iter()
             .any(|p| p.max_normal_impulse > 0.0)
     }
 
     /// Starts the replay: points that hit faster than `threshold` before the solver
     /// acted remember how fast; the others learn it during the replay.
-    pub fn begin_replay(&mut self, threshold: Real) {
-        for p in &mut self.points[..self.count] {
-            p.replay_impulse = 0.0;
-            p.replay_bounced = false;
-            p.bounce_target = None;
-            p.replay_approach = if p.start_velocity < -threshold {
-                p.approach_velocity
+    pub fn begin_replay(&self, points: &mut Points, threshold: Real) {
+        for c in &mut points.cold[self.range()] {
+            c.replay_impulse = 0.0;
+            c.replay_bounced = false;
+            c.bounce_target = None;
+            c.replay_approach = if c.start_velocity < -threshold {
+                c.approach_velocity
             } else {
                 Real::INFINITY
             };
         }
+    }
+
+    /// The touched points (pushed this step, with a body that can respond), hot and cold.
+    fn touched_points<'p>(
+        &self,
+        points: &'p mut Points,
+    ) -> impl Iterator<Item = (&'p mut Point, &'p mut PointCold)> {
+        points.hot[self.range()]
+            .iter_mut()
+            .zip(&mut points.cold[self.range()])
+            .filter(|(p, _)| p.max_normal_impulse > 0.0 && p.normal.mass > 0.0)
     }
 
     /// One replay visit. If the manifold's touched points approach, that is a collision
@@ -493,38 +627,44 @@ impl ContactConstraint {
     /// so that each point leaves at −e times its approach, or merely stops approaching
     /// below `threshold`. Later visits see a new collision only if a later impact sets
     /// the pair approaching again. Returns the largest velocity change made.
-    pub fn replay(&mut self, velocities: &mut [BodyState], threshold: Real) -> Real {
+    pub fn replay(
+        &self,
+        points: &mut Points,
+        velocities: &mut [BodyState],
+        threshold: Real,
+    ) -> Real {
         let Some((a, b)) = pair(velocities, self.a, self.b) else {
             return 0.0;
         };
         let n = self.normal;
-        let touched = |p: &&mut Point| p.max_normal_impulse > 0.0 && p.normal.mass > 0.0;
-        let approaching = self.points[..self.count]
-            .iter_mut()
-            .filter(touched)
-            .any(|p| p.normal.velocity(n, a, b) < -TOLERANCE * threshold);
+        let approaching = self
+            .touched_points(points)
+            .any(|(p, _)| p.normal.velocity(n, (p.ra, p.rb), a, b) < -TOLERANCE * threshold);
         if !approaching {
             return 0.0;
         }
-        for p in self.points[..self.count].iter_mut().filter(touched) {
-            let approach = p.normal.velocity(n, a, b).min(p.replay_approach);
-            p.replay_target = if approach < -threshold {
-                p.replay_bounced |= self.restitution > 0.0;
+        for (p, c) in self.touched_points(points) {
+            let approach = p
+                .normal
+                .velocity(n, (p.ra, p.rb), a, b)
+                .min(c.replay_approach);
+            c.replay_target = if approach < -threshold {
+                c.replay_bounced |= self.restitution > 0.0;
                 -self.restitution * approach
             } else {
                 0.0
             };
-            p.replay_impulse = 0.0;
+            c.replay_impulse = 0.0;
         }
         let mut largest: Real = 0.0;
         for _ in 0..REPLAY_ITERATIONS {
-            for p in self.points[..self.count].iter_mut().filter(touched) {
+            for (p, c) in self.touched_points(points) {
                 // Only the first collision uses the step's measured approach.
-                p.replay_approach = Real::INFINITY;
-                let vn = p.normal.velocity(n, a, b);
-                let total = (p.replay_impulse + p.normal.mass * (p.replay_target - vn)).max(0.0);
-                let applied = total - p.replay_impulse;
-                p.replay_impulse = total;
+                c.replay_approach = Real::INFINITY;
+                let vn = p.normal.velocity(n, (p.ra, p.rb), a, b);
+                let total = (c.replay_impulse + p.normal.mass * (c.replay_target - vn)).max(0.0);
+                let applied = total - c.replay_impulse;
+                c.replay_impulse = total;
                 largest = largest.max((applied / p.normal.mass).abs());
                 p.normal
                     .apply(applied, (self.push_a[0], self.push_b[0]), self.moves, a, b);
@@ -535,12 +675,15 @@ impl ContactConstraint {
 
     /// Ends the replay: a point that bounced in it aims for the separation speed it
     /// reached there; the others only for not approaching.
-    pub fn end_replay(&mut self, velocities: &[BodyState]) {
+    pub fn end_replay(&self, points: &mut Points, velocities: &[BodyState]) {
         let n = self.normal;
         let (a, b) = (&velocities[self.a], &velocities[self.b]);
-        for p in &mut self.points[..self.count] {
-            if p.replay_bounced {
-                p.bounce_target = Some(p.normal.velocity(n, a, b).max(0.0));
+        for (p, c) in points.hot[self.range()]
+            .iter()
+            .zip(&mut points.cold[self.range()])
+        {
+            if c.replay_bounced {
+                c.bounce_target = Some(p.normal.velocity(n, (p.ra, p.rb), a, b).max(0.0));
             }
         }
     }
@@ -549,22 +692,19 @@ impl ContactConstraint {
     /// velocity change made. The impulse it adds is kept apart from the normal impulse:
     /// a bounce happens once, and warm-starting the next step with it would push the
     /// bodies apart again (measured: a cradle's first ball recoiling at 0.3 m/s).
-    pub fn restitution(&mut self, states: &mut [BodyState]) -> Real {
+    pub fn restitution(&self, points: &mut Points, states: &mut [BodyState]) -> Real {
         let Some((a, b)) = pair(states, self.a, self.b) else {
             return 0.0;
         };
         let n = self.normal;
         let mut largest: Real = 0.0;
-        for p in self.points[..self.count]
-            .iter_mut()
-            .filter(|p| p.max_normal_impulse > 0.0 && p.normal.mass > 0.0)
-        {
-            let vn = p.normal.velocity(n, a, b);
-            let target = p.bounce_target.unwrap_or(0.0);
-            let before = p.normal_impulse + p.bounce_impulse;
+        for (p, c) in self.touched_points(points) {
+            let vn = p.normal.velocity(n, (p.ra, p.rb), a, b);
+            let target = c.bounce_target.unwrap_or(0.0);
+            let before = p.normal_impulse + c.bounce_impulse;
             let applied = (before + p.normal.mass * (target - vn)).max(0.0) - before;
-            p.bounce_impulse += applied;
-            p.total_normal += applied;
+            c.bounce_impulse += applied;
+            c.total_normal += applied;
             largest = largest.max((applied / p.normal.mass).abs());
             p.normal
                 .apply(applied, (self.push_a[0], self.push_b[0]), self.moves, a, b);
@@ -574,30 +714,32 @@ impl ContactConstraint {
 
     /// Adds the substep's impulses to the step's totals (each substep applies the
     /// accumulated impulse in full: warm start plus corrections).
-    pub fn add_to_totals(&mut self) {
-        for p in &mut self.points[..self.count] {
-            p.total_normal += p.normal_impulse;
-            p.total_tangent[0] += p.tangent_impulse[0];
-            p.total_tangent[1] += p.tangent_impulse[1];
+    pub fn add_to_totals(hot: &[Point], cold: &mut [PointCold]) {
+        for (p, c) in hot.iter().zip(cold) {
+            c.total_normal += p.normal_impulse;
+            c.total_tangent[0] += p.tangent_impulse[0];
+            c.total_tangent[1] += p.tangent_impulse[1];
         }
     }
 
     /// Writes the impulses into the contact for next step's warm start and for reports.
-    pub fn store_impulses(&self, contact: &mut Contact) {
-        for (mp, p) in contact
+    pub fn store_impulses(&self, points: &Points, contact: &mut Contact) {
+        let hot = &points.hot[self.range()];
+        let cold = &points.cold[self.range()];
+        for (mp, (p, c)) in contact
             .manifold
             .points_mut()
             .iter_mut()
-            .zip(&self.points[..self.count])
+            .zip(hot.iter().zip(cold))
         {
             mp.normal_impulse = p.normal_impulse;
             mp.tangent_impulse = p.tangent_impulse;
-            mp.total_normal_impulse = p.total_normal;
+            mp.total_normal_impulse = c.total_normal;
             let cone = self.friction * p.normal_impulse;
             let friction = (p.tangent_impulse[0].powi(2) + p.tangent_impulse[1].powi(2)).sqrt();
             mp.sliding = p.normal_impulse == 0.0 || friction >= 0.999 * cone;
             mp.total_tangent_impulse =
-                self.tangents[0] * p.total_tangent[0] + self.tangents[1] * p.total_tangent[1];
+                self.tangents[0] * c.total_tangent[0] + self.tangents[1] * c.total_tangent[1];
         }
     }
 }

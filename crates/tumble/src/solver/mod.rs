@@ -25,7 +25,7 @@ mod softness;
 pub use softness::Softness;
 
 use body::{BodySim, BodyState};
-use contact::{BiasRule, ContactConstraint, PairData};
+use contact::{BiasRule, ContactConstraint, PairData, Points};
 use joint::{JointConstraint, JointPass};
 
 use crate::body::{Body, BodyKind};
@@ -131,10 +131,10 @@ pub(crate) struct Solver {
     start_states: Vec<BodyState>,
     moving: Vec<bool>,
     constraints: Vec<ContactConstraint>,
+    points: Points,
     joints: Vec<JointConstraint>,
     /// Bodies whose kick is split around the drift (see `split_kicks`).
     split_kick: Vec<bool>,
-
     wrench: Vec<Wrench>,
     motions: Vec<Motion>,
 }
@@ -160,7 +160,7 @@ impl Solver {
         }
         self.start_states.clone_from(&self.states);
         let rule = bias_rule(input.settings, input.scales, h);
-        self.prepare(bodies, contacts, input.ghosts);
+        self.prepare(contacts, input.ghosts);
         self.prepare_joints(bodies, input.joints, input.joint_bodies);
         let (solve_pass, relax_pass) = joint_passes(input.settings, h);
         let any_split = self.split_kicks();
@@ -172,32 +172,35 @@ impl Solver {
                 j.warm_start(&self.sims, &mut self.states);
             }
             for c in &self.constraints {
-                c.warm_start(&mut self.states);
+                c.warm_start(&self.points.hot, &mut self.states);
             }
-            for _ in 0..input.settings.iterations {
+            // The substep's impulses are final once the last pass has visited a
+            // manifold, so that pass adds them to the step's totals on its way instead
+            // of a separate walk over every point.
+            let iterations = input.settings.iterations;
+            let relax = input.settings.kind == SolverKind::SoftStep && iterations > 0;
+            for k in 0..iterations {
+                let totals = !relax && k + 1 == iterations;
                 for j in &mut self.joints {
                     j.solve(&self.sims, &mut self.states, &solve_pass);
                 }
-                for c in &mut self.constraints {
-                    c.solve(&mut self.states, &rule, true);
-                }
+                self.solve_pass(&rule, true, totals);
             }
             self.drift(bodies, h);
             if any_split {
                 self.kick(input.system, t + h, h, true, true);
             }
-            if input.settings.kind == SolverKind::SoftStep {
-                for _ in 0..input.settings.iterations {
+            if relax {
+                for k in 0..iterations {
+                    let totals = k + 1 == iterations;
                     for j in &mut self.joints {
                         j.solve(&self.sims, &mut self.states, &relax_pass);
                     }
-                    for c in &mut self.constraints {
-                        c.solve(&mut self.states, &rule, false);
-                    }
+                    self.solve_pass(&rule, false, totals);
                 }
             }
-            for c in &mut self.constraints {
-                c.add_to_totals();
+            if iterations == 0 {
+                ContactConstraint::add_to_totals(&self.points.hot, &mut self.points.cold);
             }
             for j in &mut self.joints {
                 j.add_to_totals(&self.sims);
@@ -209,14 +212,15 @@ impl Solver {
         self.moving.clear();
         self.moving.extend(self.sims.iter().map(|s| s.moves));
         restitution::resolve_bounces(
-            &mut self.constraints,
+            &self.constraints,
+            &mut self.points,
             &mut self.states,
             &self.start_states,
             &self.moving,
             input.scales.restitution_threshold,
         );
         for c in &self.constraints {
-            c.store_impulses(&mut contacts[c.contact]);
+            c.store_impulses(&self.points, &mut contacts[c.contact]);
         }
         for ((m, sim), (state, body)) in motions
             .iter_mut()
@@ -236,16 +240,18 @@ impl Solver {
         }
     }
 
-    fn prepare(&mut self, bodies: &[Body], contacts: &[Contact], ghosts: &[bool]) {
+    fn prepare(&mut self, contacts: &[Contact], ghosts: &[bool]) {
         self.constraints.clear();
-        for i in self.colour_order(contacts, ghosts) {
+        self.points.clear();
+        for (colour, i) in self.colour_order(contacts, ghosts) {
             let c = &contacts[i];
             let (a, b) = (c.index_a as usize, c.index_b as usize);
-            let friction = (bodies[a].friction * bodies[b].friction).sqrt();
-            let restitution = bodies[a].restitution.max(bodies[b].restitution);
+            let (sa, sb) = (&self.sims[a], &self.sims[b]);
+            let friction = (sa.friction * sb.friction).sqrt();
+            let restitution = sa.restitution.max(sb.restitution);
             let pose = |k: usize| {
                 let s = &self.sims[k];
-                crate::geometry::Pose::new(s.x - s.q * bodies[k].local_center, s.q)
+                crate::geometry::Pose::new(s.x - s.q * s.local_center, s.q)
             };
             let pair = PairData {
                 bodies: (a, b),
@@ -253,11 +259,11 @@ impl Solver {
                 poses: (pose(a), pose(b)),
             };
             self.constraints.push(ContactConstraint::prepare(
-                i,
+                (i, colour),
                 c,
                 &pair,
-                &self.sims,
-                &self.states,
+                (&self.sims, &self.states),
+                &mut self.points,
             ));
         }
     }
@@ -304,7 +310,7 @@ impl Solver {
     /// body (greedy graph colouring, colour by colour). Gauss–Seidel passes are a chain of
     /// dependent updates; constraints on disjoint bodies let the processor overlap them.
     /// Deterministic: colours depend only on the contacts' order, itself deterministic.
-    fn colour_order(&self, contacts: &[Contact], ghosts: &[bool]) -> Vec<usize> {
+    fn colour_order(&self, contacts: &[Contact], ghosts: &[bool]) -> Vec<(u32, usize)> {
         let mut used = vec![0u64; self.sims.len()];
         let mut coloured = Vec::with_capacity(contacts.len());
         for (i, c) in contacts.iter().enumerate() {
@@ -323,7 +329,27 @@ impl Solver {
             coloured.push((colour, i));
         }
         coloured.sort_unstable();
-        coloured.into_iter().map(|(_, i)| i).collect()
+        coloured
+    }
+
+    /// One pass over every constraint, in colour order; neighbours of one colour are
+    /// solved two at a time (see `ContactConstraint::solve_two`).
+    fn solve_pass(&mut self, rule: &BiasRule, bias: bool, totals: bool) {
+        let cs = &self.constraints;
+        let mut i = 0;
+        while i < cs.len() {
+            match cs.get(i + 1).filter(|next| cs[i].pairs_with(next)) {
+                Some(next) => {
+                    let pass = (rule, bias, totals);
+                    cs[i].solve_two(next, &mut self.points, &mut self.states, pass);
+                    i += 2;
+                }
+                None => {
+                    cs[i].solve(&mut self.points, &mut self.states, rule, bias, totals);
+                    i += 1;
+                }
+            }
+        }
     }
 
     /// v += h F/m, L += h N, over the substep's start (`end` false) or end: bodies in

@@ -15,7 +15,7 @@
 //! Steps without a bounce skip all of this.
 
 use super::body::BodyState;
-use super::contact::{ContactConstraint, TOLERANCE};
+use super::contact::{ContactConstraint, Points, TOLERANCE};
 use crate::math::Real;
 
 /// Passes allowed for the replay and for the final pass; a row of n bodies needs about n
@@ -24,36 +24,37 @@ const MAX_PASSES: usize = 64;
 
 /// Resolves the step's bounces; `start` holds the velocities of the step's start.
 pub(crate) fn resolve_bounces(
-    constraints: &mut [ContactConstraint],
+    constraints: &[ContactConstraint],
+    points: &mut Points,
     states: &mut [BodyState],
     start: &[BodyState],
     moves: &[bool],
     threshold: Real,
 ) {
-    let cluster = bounce_cluster(constraints, moves, threshold);
+    let cluster = bounce_cluster(constraints, points, moves, threshold);
     if cluster.is_empty() {
         return;
     }
     let mut replayed = start.to_vec();
     for &k in &cluster {
-        constraints[k].begin_replay(threshold);
+        constraints[k].begin_replay(points, threshold);
     }
     for _ in 0..MAX_PASSES {
         let mut largest: Real = 0.0;
         for &k in &cluster {
-            largest = largest.max(constraints[k].replay(&mut replayed, threshold));
+            largest = largest.max(constraints[k].replay(points, &mut replayed, threshold));
         }
         if largest < TOLERANCE * threshold {
             break;
         }
     }
     for &k in &cluster {
-        constraints[k].end_replay(&replayed);
+        constraints[k].end_replay(points, &replayed);
     }
     for _ in 0..MAX_PASSES {
         let mut largest: Real = 0.0;
         for &k in &cluster {
-            largest = largest.max(constraints[k].restitution(states));
+            largest = largest.max(constraints[k].restitution(points, states));
         }
         if largest < TOLERANCE * threshold {
             break;
@@ -65,12 +66,13 @@ pub(crate) fn resolve_bounces(
 /// bounces; in the solver's order. Empty when nothing bounces.
 fn bounce_cluster(
     constraints: &[ContactConstraint],
+    points: &Points,
     moves: &[bool],
     threshold: Real,
 ) -> Vec<usize> {
     let mut reached = vec![false; moves.len()];
     let mut seeded = false;
-    for c in constraints.iter().filter(|c| c.bounces(threshold)) {
+    for c in constraints.iter().filter(|c| c.bounces(points, threshold)) {
         let (a, b) = c.bodies();
         reached[a] |= moves[a];
         reached[b] |= moves[b];
@@ -82,7 +84,7 @@ fn bounce_cluster(
     // Spread through touched constraints until nothing changes; a pass per link of the
     // longest chain, each linear in the number of constraints.
     let touched: Vec<usize> = (0..constraints.len())
-        .filter(|&k| constraints[k].touched())
+        .filter(|&k| constraints[k].touched(points))
         .collect();
     loop {
         let mut grew = false;
