@@ -14,7 +14,9 @@ use crate::world::{body_arg, Inner, PyWorld};
 /// at most `max_force` (N·m for hinges, N for sliders).
 #[pyclass(module = "tumble", name = "Motor", frozen, get_all)]
 pub struct PyMotor {
+    /// Target speed (rad/s for hinges, m/s for sliders).
     speed: f64,
+    /// Largest torque (N·m) or force (N) the motor may exert.
     max_force: f64,
 }
 
@@ -35,8 +37,11 @@ impl PyMotor {
 /// length is its `length`).
 #[pyclass(module = "tumble", name = "JointSpring", frozen, get_all)]
 pub struct PyJointSpring {
+    /// Natural frequency (Hz).
     hertz: f64,
+    /// Damping ratio (1 = critical).
     damping_ratio: f64,
+    /// Rest angle (rad) or position (m).
     target: f64,
 }
 

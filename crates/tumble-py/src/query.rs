@@ -15,10 +15,15 @@ use crate::world::{body_arg, Inner, PyWorld};
 /// (compound child or mesh triangle).
 #[pyclass(module = "tumble", name = "RayHit", frozen, get_all)]
 pub struct RayHit {
+    /// The body hit.
     body: Py<PyBody>,
+    /// Ray parameter: the hit is at origin + t·direction.
     t: f64,
+    /// Where the ray hits (m, world), (3,).
     point: Py<PyArray1<f64>>,
+    /// Unit surface normal there, (3,).
     normal: Py<PyArray1<f64>>,
+    /// Index of the compound child or mesh triangle hit.
     subshape: u32,
 }
 
@@ -34,9 +39,13 @@ impl RayHit {
 /// towards the cast shape.
 #[pyclass(module = "tumble", name = "ShapeHit", frozen, get_all)]
 pub struct ShapeHit {
+    /// The body hit.
     body: Py<PyBody>,
+    /// Fraction of the translation travelled before touching, in [0, 1].
     t: f64,
+    /// Contact point (m, world), (3,).
     point: Py<PyArray1<f64>>,
+    /// Unit normal on the body hit, towards the cast shape, (3,).
     normal: Py<PyArray1<f64>>,
 }
 
@@ -53,11 +62,17 @@ impl ShapeHit {
 /// step: divide by dt for the mean force.
 #[pyclass(module = "tumble", name = "ContactPoint", frozen, get_all)]
 pub struct ContactPoint {
+    /// The point midway between the two surfaces (m), (3,).
     position: Py<PyArray1<f64>>,
+    /// The point on body_a's surface (m), (3,).
     point_a: Py<PyArray1<f64>>,
+    /// The point on body_b's surface (m), (3,).
     point_b: Py<PyArray1<f64>>,
+    /// Distance between the surfaces along the normal (m); negative when penetrating.
     separation: f64,
+    /// Normal impulse applied over the last step (N·s).
     normal_impulse: f64,
+    /// Friction impulse applied over the last step (N·s, world), (3,).
     tangent_impulse: Py<PyArray1<f64>>,
 }
 
@@ -65,9 +80,13 @@ pub struct ContactPoint {
 /// to four `points`.
 #[pyclass(module = "tumble", name = "Contact", frozen, get_all)]
 pub struct Contact {
+    /// The first body; the normal points away from it.
     body_a: Py<PyBody>,
+    /// The second body.
     body_b: Py<PyBody>,
+    /// Unit normal from body_a to body_b, (3,).
     normal: Py<PyArray1<f64>>,
+    /// Up to four ContactPoints.
     points: Vec<Py<ContactPoint>>,
 }
 
@@ -92,8 +111,11 @@ impl Contact {
 /// Two bodies started (`kind` "begin") or stopped ("end") touching at the last step.
 #[pyclass(module = "tumble", name = "ContactEvent", frozen, get_all)]
 pub struct ContactEvent {
+    /// "begin" or "end".
     kind: &'static str,
+    /// The first body (lower creation order).
     body_a: Py<PyBody>,
+    /// The second body.
     body_b: Py<PyBody>,
 }
 

@@ -18,16 +18,27 @@ use crate::world::PyWorld;
 /// (T, 3); otherwise those are None.
 #[pyclass(module = "tumble", name = "Trajectory", frozen, get_all)]
 pub struct Trajectory {
+    /// Times of the recorded frames (s), (T,).
     time: Py<PyAny>,
+    /// Each body frame's origin (m), (T, N, 3).
     position: Py<PyAny>,
+    /// Orientations as quaternions [x, y, z, w], (T, N, 4).
     orientation: Py<PyAny>,
+    /// Centre-of-mass velocities (m/s), (T, N, 3).
     velocity: Py<PyAny>,
+    /// Angular velocities (rad/s, world frame), (T, N, 3).
     angular_velocity: Py<PyAny>,
+    /// Kinetic energy (J), (T,); None unless simulate(diagnostics=True).
     kinetic: Option<Py<PyAny>>,
+    /// Potential energy (J), (T,); None unless diagnostics=True.
     potential: Option<Py<PyAny>>,
+    /// Total energy (J), (T,); None unless diagnostics=True.
     total: Option<Py<PyAny>>,
+    /// Linear momentum (kg·m/s), (T, 3); None unless diagnostics=True.
     linear_momentum: Option<Py<PyAny>>,
+    /// Angular momentum about the origin (kg·m²/s), (T, 3); None unless diagnostics=True.
     angular_momentum: Option<Py<PyAny>>,
+    /// The bodies' names (None if unnamed), in the arrays' order.
     names: Vec<Option<String>>,
 }
 

@@ -105,13 +105,21 @@ fn count(value: i64, field: &str) -> PyResult<u32> {
 #[pyclass(module = "tumble", name = "SolverSettings", get_all, set_all)]
 #[derive(Clone)]
 pub struct PySolverSettings {
+    /// "soft_step" or "pgs".
     kind: String,
+    /// Solver substeps per step (>= 1).
     substeps: i64,
+    /// Solve (and relax) passes per substep (>= 1).
     iterations: i64,
+    /// Contact stiffness (Hz), capped at a quarter of the substep rate.
     contact_hertz: f64,
+    /// Damping ratio of the contact spring.
     contact_damping_ratio: f64,
+    /// PGS's fraction of the position error corrected per substep.
     baumgarte: f64,
+    /// Stiffness of the joints' drift correction (Hz).
     joint_hertz: f64,
+    /// Damping ratio of the joints' drift correction.
     joint_damping_ratio: f64,
 }
 
@@ -195,10 +203,15 @@ impl PySolverSettings {
 /// (kg·m/s) and `angular_momentum` about the world origin (kg·m²/s) as arrays (3,).
 #[pyclass(module = "tumble", name = "Diagnostics", frozen, get_all)]
 pub struct PyDiagnostics {
+    /// Kinetic energy (J).
     kinetic: f64,
+    /// Potential energy (J): gravity, zero at the origin, plus springs.
     potential: f64,
+    /// Kinetic plus potential (J).
     total: f64,
+    /// Linear momentum (kg·m/s), (3,).
     linear_momentum: Py<PyArray1<f64>>,
+    /// Angular momentum about the world origin (kg·m²/s), (3,).
     angular_momentum: Py<PyArray1<f64>>,
 }
 

@@ -243,3 +243,17 @@ def test_simulate_releases_the_interpreter():
     assert time.perf_counter() - t0 > 0.05
     assert count > 1000
     assert busy
+
+
+def test_every_public_name_has_a_docstring_and_a_stub(root):
+    stub = (root / "crates/tumble-py/python/tumble/_tumble.pyi").read_text()
+    for name in tumble.__all__:
+        obj = getattr(tumble, name)
+        if isinstance(obj, type):
+            assert obj.__doc__, name
+            assert f"class {name}" in stub, name
+            for attr, value in vars(obj).items():
+                if not attr.startswith("_"):
+                    assert value.__doc__, f"{name}.{attr}"
+                    assert f" {attr}" in stub, f"{name}.{attr}"
+    assert (root / "crates/tumble-py/python/tumble/py.typed").exists()
