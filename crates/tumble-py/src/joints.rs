@@ -66,8 +66,8 @@ impl PyJointSpring {
 }
 
 /// A joint in a world: its `name`, `kind`, `body` and `other` (None: the world), whether it
-/// is `broken`, and the `reaction_force` (N) and `reaction_torque` (N·m) it applied on
-/// `body` at the last step.
+/// is `broken`, and the `reaction_force` (N) and `reaction_torque` (N·m) it applied to
+/// `other` over the last step (`body` felt the opposite).
 #[pyclass(module = "tumble", name = "Joint", frozen)]
 pub struct PyJoint {
     world: Py<PyWorld>,
@@ -116,13 +116,15 @@ impl PyJoint {
         self.read(|j| j.is_broken())
     }
 
-    /// Force the joint applied on `body` over the last step (N, world frame), array (3,).
+    /// Force the joint applied to `other` over the last step (N, world frame), array (3,);
+    /// the force on `body` is its opposite.
     #[getter]
     fn reaction_force<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         Ok(vec3_out(py, self.read(|j| j.reaction_force())?))
     }
 
-    /// Torque the joint applied on `body` over the last step (N·m, world frame).
+    /// Torque the joint applied to `other` about its anchor over the last step (N·m, world
+    /// frame), array (3,).
     #[getter]
     fn reaction_torque<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         Ok(vec3_out(py, self.read(|j| j.reaction_torque())?))

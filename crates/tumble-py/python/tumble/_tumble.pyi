@@ -283,10 +283,10 @@ class Joint:
     def broken(self) -> bool: ...
     @property
     def reaction_force(self) -> F64Array:
-        """Force on `body` over the last step (N), (3,)."""
+        """Force applied to `other` over the last step (N), (3,); `body` felt the opposite."""
     @property
     def reaction_torque(self) -> F64Array:
-        """Torque on `body` over the last step (N·m), (3,)."""
+        """Torque applied to `other` about its anchor over the last step (N·m), (3,)."""
     @property
     def alive(self) -> bool: ...
 
