@@ -1,0 +1,73 @@
+"""Tumble: a rigid-body dynamics engine with a Rust core, driven from Python.
+
+>>> import tumble
+>>> world = tumble.World(gravity=(0, -9.8, 0), integrator="velocity_verlet")
+>>> ball = world.add_body(tumble.Sphere(0.1), mass=1.0, position=(0, 5, 0))
+>>> traj = world.simulate(duration=1.0, dt=0.01)
+>>> traj.position.shape
+(101, 1, 3)
+
+SI units throughout (m, kg, s, rad, N); quaternions are [x, y, z, w]; arrays are float64.
+Bad input raises ValueError or TypeError whose message starts with the field's name, as
+the command-line program prints it: ``shape.radius: must be > 0``.
+"""
+
+from ._tumble import (
+    INTEGRATORS,
+    SCENES,
+    SINGLE_PRECISION,
+    Body,
+    Box,
+    Capsule,
+    Compound,
+    Contact,
+    ContactEvent,
+    ContactPoint,
+    ConvexHull,
+    Cylinder,
+    Diagnostics,
+    HeightField,
+    Joint,
+    JointSpring,
+    Motor,
+    Plane,
+    RayHit,
+    Shape,
+    ShapeHit,
+    SolverSettings,
+    Sphere,
+    Trajectory,
+    TriMesh,
+    World,
+    __version__,
+)
+
+__all__ = [
+    "INTEGRATORS",
+    "SCENES",
+    "SINGLE_PRECISION",
+    "Body",
+    "Box",
+    "Capsule",
+    "Compound",
+    "Contact",
+    "ContactEvent",
+    "ContactPoint",
+    "ConvexHull",
+    "Cylinder",
+    "Diagnostics",
+    "HeightField",
+    "Joint",
+    "JointSpring",
+    "Motor",
+    "Plane",
+    "RayHit",
+    "Shape",
+    "ShapeHit",
+    "SolverSettings",
+    "Sphere",
+    "Trajectory",
+    "TriMesh",
+    "World",
+    "__version__",
+]

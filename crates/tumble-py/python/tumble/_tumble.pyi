@@ -1,0 +1,528 @@
+"""Type stubs of the extension module behind `import tumble` (crates/tumble-py/src)."""
+
+from os import PathLike
+from typing import Literal, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+INTEGRATORS: list[str]
+"""The integrators' names: explicit_euler, symplectic_euler, implicit_euler, midpoint, rk4, verlet, velocity_verlet."""
+SCENES: list[str]
+"""The built-in scenes' names, for World.from_scene."""
+SINGLE_PRECISION: bool
+"""Whether the core was built with f32 numbers (arrays are float64 either way)."""
+
+Vec3Like = Union[Sequence[float], npt.ArrayLike]
+QuatLike = Union[Sequence[float], npt.ArrayLike]
+F64Array = npt.NDArray[np.float64]
+BodyLike = Union["Body", str]
+
+class Shape:
+    """A collision shape; make one with a subclass. Immutable, shareable between bodies."""
+
+    @property
+    def kind(self) -> str:
+        """The kind as named in scene files: "sphere", "box", ..."""
+    @property
+    def volume(self) -> float:
+        """Volume (m³); 0 for plane, mesh and height field."""
+
+class Sphere(Shape):
+    """A ball of `radius` (m) centred on the body's origin."""
+
+    def __init__(self, radius: float) -> None: ...
+
+class Box(Shape):
+    """A box with half extents [x, y, z] (m), centred on the body's origin."""
+
+    def __init__(self, half_extents: Vec3Like) -> None: ...
+
+class Capsule(Shape):
+    """A capsule along local y: shaft half length `half_height` (m), caps of `radius` (m)."""
+
+    def __init__(self, radius: float, half_height: float) -> None: ...
+
+class Cylinder(Shape):
+    """A solid cylinder along local y, of `radius` and half length `half_height` (m)."""
+
+    def __init__(self, radius: float, half_height: float) -> None: ...
+
+class ConvexHull(Shape):
+    """The convex hull of (N, 3) points (m, body frame): at least 4, not coplanar."""
+
+    def __init__(self, points: npt.ArrayLike) -> None: ...
+
+class Compound(Shape):
+    """Shapes rigidly joined: shapes or (shape, position[, orientation]) tuples."""
+
+    def __init__(
+        self,
+        children: Sequence[Union[Shape, Tuple[Shape, Vec3Like], Tuple[Shape, Vec3Like, QuatLike]]],
+    ) -> None: ...
+
+class Plane(Shape):
+    """The half-space normal·x ≤ offset (body frame). Static bodies only."""
+
+    def __init__(self, normal: Vec3Like, offset: float = 0.0) -> None: ...
+
+class TriMesh(Shape):
+    """A triangle mesh: vertices (N, 3) in m, indices (M, 3), counter-clockwise fronts. Static only."""
+
+    def __init__(self, vertices: npt.ArrayLike, indices: npt.ArrayLike) -> None: ...
+
+class HeightField(Shape):
+    """Terrain from a 2-D array of heights (rows along z, columns along x), scaled by [sx, sy, sz]. Static only."""
+
+    def __init__(self, heights: npt.ArrayLike, scale: Optional[Vec3Like] = None) -> None: ...
+
+class Body:
+    """A handle on a body; properties read the live state, four are assignable."""
+
+    @property
+    def world(self) -> World:
+        """The world this body is in."""
+    @property
+    def name(self) -> Optional[str]:
+        """The body's name, or None."""
+    @property
+    def kind(self) -> Literal["dynamic", "kinematic", "static"]:
+        """How the body moves."""
+    @property
+    def shape_kind(self) -> str:
+        """The shape's kind ("sphere", "box", ...)."""
+    @property
+    def alive(self) -> bool:
+        """Whether the body still exists."""
+    @property
+    def mass(self) -> float:
+        """Mass (kg)."""
+    @property
+    def inertia(self) -> F64Array:
+        """Inertia about the centre of mass, body axes (kg·m²), (3, 3)."""
+    @property
+    def inertia_world(self) -> F64Array:
+        """Inertia about the centre of mass, world axes (kg·m²), (3, 3)."""
+    @property
+    def position(self) -> F64Array:
+        """World position of the body frame's origin (m), (3,)."""
+    @position.setter
+    def position(self, value: Vec3Like) -> None: ...
+    @property
+    def center_of_mass(self) -> F64Array:
+        """World position of the centre of mass (m), (3,)."""
+    @property
+    def orientation(self) -> F64Array:
+        """Unit quaternion [x, y, z, w], body to world, (4,)."""
+    @orientation.setter
+    def orientation(self, value: QuatLike) -> None: ...
+    @property
+    def velocity(self) -> F64Array:
+        """Centre-of-mass velocity (m/s, world), (3,)."""
+    @velocity.setter
+    def velocity(self, value: Vec3Like) -> None: ...
+    @property
+    def angular_velocity(self) -> F64Array:
+        """Angular velocity (rad/s, world), (3,)."""
+    @angular_velocity.setter
+    def angular_velocity(self, value: Vec3Like) -> None: ...
+    @property
+    def linear_momentum(self) -> F64Array:
+        """m v (kg·m/s), (3,)."""
+    @property
+    def angular_momentum(self) -> F64Array:
+        """Angular momentum about the centre of mass (kg·m²/s, world), (3,)."""
+    @property
+    def kinetic_energy(self) -> float:
+        """Translational plus rotational kinetic energy (J)."""
+    @property
+    def awake(self) -> bool:
+        """False while the body's island sleeps."""
+    @property
+    def planar(self) -> bool:
+        """Whether the body is confined to the xy plane."""
+    @property
+    def friction(self) -> float:
+        """Coulomb friction coefficient."""
+    @property
+    def restitution(self) -> float:
+        """Coefficient of restitution."""
+    def apply_impulse(self, impulse: Vec3Like, point: Optional[Vec3Like] = None) -> None:
+        """Applies an impulse (N·s) at a world point (m; default the centre of mass)."""
+    def wake(self) -> None:
+        """Wakes the body's island and the islands touching it."""
+    def __eq__(self, other: object) -> bool: ...
+    def __hash__(self) -> int: ...
+
+class SolverSettings:
+    """Contact and joint solver settings; read world.solver_settings, change, assign back."""
+
+    kind: str
+    substeps: int
+    iterations: int
+    contact_hertz: float
+    contact_damping_ratio: float
+    baumgarte: float
+    joint_hertz: float
+    joint_damping_ratio: float
+    def __init__(
+        self,
+        *,
+        kind: str = "soft_step",
+        substeps: int = 4,
+        iterations: int = 1,
+        contact_hertz: float = 60.0,
+        contact_damping_ratio: float = 10.0,
+        baumgarte: float = 0.2,
+        joint_hertz: float = 1000.0,
+        joint_damping_ratio: float = 0.5,
+    ) -> None: ...
+
+class Diagnostics:
+    """Energies (J) and momenta of a state, over the dynamic bodies."""
+
+    kinetic: float
+    potential: float
+    total: float
+    linear_momentum: F64Array
+    angular_momentum: F64Array
+    """About the world origin (kg·m²/s)."""
+
+class Trajectory:
+    """A recorded run; arrays are float64, bodies in creation order."""
+
+    time: F64Array
+    """(T,) in s."""
+    position: F64Array
+    """(T, N, 3) in m."""
+    orientation: F64Array
+    """(T, N, 4) quaternions [x, y, z, w]."""
+    velocity: F64Array
+    """(T, N, 3) in m/s."""
+    angular_velocity: F64Array
+    """(T, N, 3) in rad/s."""
+    kinetic: Optional[F64Array]
+    potential: Optional[F64Array]
+    total: Optional[F64Array]
+    linear_momentum: Optional[F64Array]
+    angular_momentum: Optional[F64Array]
+    names: list[Optional[str]]
+    def __len__(self) -> int: ...
+
+class RayHit:
+    """A ray's hit: body, parameter t, point and normal (world), subshape index."""
+
+    body: Body
+    t: float
+    point: F64Array
+    normal: F64Array
+    subshape: int
+
+class ShapeHit:
+    """A shape cast's hit: body, fraction t of the translation, point and normal."""
+
+    body: Body
+    t: float
+    point: F64Array
+    normal: F64Array
+
+class ContactPoint:
+    """One contact point, with the impulses of the last step (N·s)."""
+
+    position: F64Array
+    point_a: F64Array
+    point_b: F64Array
+    separation: float
+    normal_impulse: float
+    tangent_impulse: F64Array
+
+class Contact:
+    """A contact manifold: the normal from body_a to body_b and up to four points."""
+
+    body_a: Body
+    body_b: Body
+    normal: F64Array
+    points: list[ContactPoint]
+
+class ContactEvent:
+    """Two bodies started ("begin") or stopped ("end") touching at the last step."""
+
+    kind: Literal["begin", "end"]
+    body_a: Body
+    body_b: Body
+
+class Motor:
+    """A velocity motor: `speed` (rad/s or m/s) with at most `max_force` (N·m or N)."""
+
+    speed: float
+    max_force: float
+    def __init__(self, speed: float, max_force: float) -> None: ...
+
+class JointSpring:
+    """A spring on a joint's free coordinate: `hertz`, `damping_ratio`, `target`."""
+
+    hertz: float
+    damping_ratio: float
+    target: float
+    def __init__(self, hertz: float, damping_ratio: float = 1.0, target: float = 0.0) -> None: ...
+
+class Joint:
+    """A handle on a joint."""
+
+    @property
+    def name(self) -> Optional[str]: ...
+    @property
+    def kind(self) -> Literal["ball", "hinge", "slider", "fixed", "distance"]: ...
+    @property
+    def body(self) -> Body: ...
+    @property
+    def other(self) -> Optional[Body]:
+        """The second body, or None for the world."""
+    @property
+    def broken(self) -> bool: ...
+    @property
+    def reaction_force(self) -> F64Array:
+        """Force applied to `other` over the last step (N), (3,); `body` felt the opposite."""
+    @property
+    def reaction_torque(self) -> F64Array:
+        """Torque applied to `other` about its anchor over the last step (N·m), (3,)."""
+    @property
+    def alive(self) -> bool: ...
+
+class World:
+    """A simulated world: bodies, force elements, joints and the step."""
+
+    def __init__(
+        self,
+        *,
+        gravity: Optional[Vec3Like] = None,
+        integrator: str = "symplectic_euler",
+        solver: str = "soft_step",
+        substeps: int = 4,
+        iterations: int = 1,
+        contact_hertz: float = 60.0,
+        contact_damping_ratio: float = 10.0,
+        joint_hertz: float = 1000.0,
+        joint_damping_ratio: float = 0.5,
+        baumgarte: float = 0.2,
+        length_unit: float = 1.0,
+        sleep: bool = True,
+    ) -> None: ...
+    @staticmethod
+    def from_scene(path: Union[str, PathLike[str]]) -> World:
+        """Loads a scene file, or a built-in scene by name (tumble.SCENES)."""
+    @staticmethod
+    def from_json(text: str) -> World:
+        """Loads a scene from JSON text."""
+    def add_body(
+        self,
+        shape: Shape,
+        *,
+        mass: Optional[float] = None,
+        density: Optional[float] = None,
+        position: Optional[Vec3Like] = None,
+        orientation: Optional[QuatLike] = None,
+        velocity: Optional[Vec3Like] = None,
+        angular_velocity: Optional[Vec3Like] = None,
+        kind: Literal["dynamic", "kinematic", "static"] = "dynamic",
+        name: Optional[str] = None,
+        planar: bool = False,
+        inertia: Optional[npt.ArrayLike] = None,
+        center_of_mass: Optional[Vec3Like] = None,
+        friction: float = 0.6,
+        restitution: float = 0.0,
+        collision_group: int = 1,
+        collision_mask: int = 0xFFFFFFFF,
+        bullet: bool = False,
+    ) -> Body:
+        """Adds a body and returns its handle."""
+    def remove_body(self, body: BodyLike) -> None:
+        """Removes a body with its force elements and joints."""
+    def body(self, name: str) -> Body:
+        """The body called `name` (KeyError if none)."""
+    @property
+    def bodies(self) -> list[Body]:
+        """Every body, in creation order."""
+    @property
+    def body_names(self) -> list[Optional[str]]: ...
+    def __len__(self) -> int: ...
+    def add_spring(
+        self,
+        body: BodyLike,
+        *,
+        stiffness: float,
+        world_point: Optional[Vec3Like] = None,
+        other: Optional[BodyLike] = None,
+        anchor: Optional[Vec3Like] = None,
+        other_anchor: Optional[Vec3Like] = None,
+        rest_length: float = 0.0,
+        damping: float = 0.0,
+    ) -> int:
+        """A spring and damper to a world point or another body; returns its id."""
+    def add_drag(self, body: BodyLike, *, linear: float = 0.0, quadratic: float = 0.0) -> int:
+        """Air drag F = −linear·v − quadratic·|v|·v; returns its id."""
+    def add_force(
+        self,
+        body: BodyLike,
+        *,
+        force: Optional[Vec3Like] = None,
+        point: Optional[Vec3Like] = None,
+        torque: Optional[Vec3Like] = None,
+    ) -> int:
+        """A constant force at a body point and a constant torque; returns its id."""
+    def remove_force(self, id: int) -> bool: ...
+    def add_joint(
+        self,
+        kind: Literal["ball", "hinge", "slider", "fixed", "distance"],
+        body: BodyLike,
+        other: Optional[BodyLike] = None,
+        *,
+        anchor: Optional[Vec3Like] = None,
+        axis: Optional[Vec3Like] = None,
+        other_anchor: Optional[Vec3Like] = None,
+        other_axis: Optional[Vec3Like] = None,
+        name: Optional[str] = None,
+        collide_connected: bool = False,
+        break_force: Optional[float] = None,
+        cone: Optional[float] = None,
+        twist: Optional[Sequence[float]] = None,
+        limits: Optional[Sequence[float]] = None,
+        motor: Optional[Motor] = None,
+        spring: Optional[JointSpring] = None,
+        length: Optional[float] = None,
+        min: Optional[float] = None,
+        max: Optional[float] = None,
+    ) -> Joint:
+        """Adds a joint between `body` and `other` (None: the world)."""
+    def remove_joint(self, joint: Joint) -> bool: ...
+    def joint(self, name: str) -> Joint:
+        """The joint called `name` (KeyError if none)."""
+    @property
+    def joints(self) -> list[Joint]: ...
+    def step(self, dt: float, steps: int = 1) -> None:
+        """Advances by `dt` seconds, `steps` times."""
+    def simulate(
+        self,
+        duration: Optional[float] = None,
+        dt: Optional[float] = None,
+        *,
+        steps: Optional[int] = None,
+        every: int = 1,
+        diagnostics: bool = False,
+    ) -> Trajectory:
+        """Runs in Rust with the interpreter released and returns the recorded trajectory."""
+    @property
+    def positions(self) -> F64Array:
+        """(N, 3) body-frame origins (m); assignable."""
+    @positions.setter
+    def positions(self, value: npt.ArrayLike) -> None: ...
+    @property
+    def orientations(self) -> F64Array:
+        """(N, 4) quaternions [x, y, z, w]; assignable."""
+    @orientations.setter
+    def orientations(self, value: npt.ArrayLike) -> None: ...
+    @property
+    def velocities(self) -> F64Array:
+        """(N, 3) centre-of-mass velocities (m/s); assignable."""
+    @velocities.setter
+    def velocities(self, value: npt.ArrayLike) -> None: ...
+    @property
+    def angular_velocities(self) -> F64Array:
+        """(N, 3) angular velocities (rad/s); assignable."""
+    @angular_velocities.setter
+    def angular_velocities(self, value: npt.ArrayLike) -> None: ...
+    @property
+    def angular_momenta(self) -> F64Array:
+        """(N, 3) angular momenta about each centre of mass (kg·m²/s)."""
+    def set_state(
+        self,
+        *,
+        positions: Optional[npt.ArrayLike] = None,
+        orientations: Optional[npt.ArrayLike] = None,
+        velocities: Optional[npt.ArrayLike] = None,
+        angular_velocities: Optional[npt.ArrayLike] = None,
+    ) -> None:
+        """Sets any of the bulk arrays at once."""
+    def cast_ray(
+        self,
+        origin: Vec3Like,
+        direction: Vec3Like,
+        max_t: float = ...,
+        *,
+        mask: int = 0xFFFFFFFF,
+        exclude: Optional[BodyLike] = None,
+    ) -> Optional[RayHit]:
+        """The nearest hit of origin + t·direction, t in [0, max_t]."""
+    def cast_ray_all(
+        self,
+        origin: Vec3Like,
+        direction: Vec3Like,
+        max_t: float = ...,
+        *,
+        mask: int = 0xFFFFFFFF,
+        exclude: Optional[BodyLike] = None,
+    ) -> list[RayHit]:
+        """Every hit, nearest first."""
+    def cast_shape(
+        self,
+        shape: Shape,
+        position: Vec3Like,
+        translation: Vec3Like,
+        orientation: Optional[QuatLike] = None,
+        *,
+        mask: int = 0xFFFFFFFF,
+        exclude: Optional[BodyLike] = None,
+    ) -> Optional[ShapeHit]:
+        """The first body a convex shape swept along `translation` touches."""
+    def query_point(
+        self, point: Vec3Like, *, mask: int = 0xFFFFFFFF, exclude: Optional[BodyLike] = None
+    ) -> list[Body]: ...
+    def query_aabb(
+        self,
+        lower: Vec3Like,
+        upper: Vec3Like,
+        *,
+        mask: int = 0xFFFFFFFF,
+        exclude: Optional[BodyLike] = None,
+    ) -> list[Body]: ...
+    def contacts(self) -> list[Contact]:
+        """The contact manifolds of the last step."""
+    def update_contacts(self) -> list[Contact]:
+        """Collision detection on the current state, without a step."""
+    def contact_events(self) -> list[ContactEvent]:
+        """Pairs that began or ended touching at the last step."""
+    @property
+    def time(self) -> float: ...
+    @property
+    def step_count(self) -> int: ...
+    @property
+    def gravity(self) -> F64Array: ...
+    @gravity.setter
+    def gravity(self, value: Vec3Like) -> None: ...
+    @property
+    def integrator(self) -> str: ...
+    @integrator.setter
+    def integrator(self, name: str) -> None: ...
+    @property
+    def sleep(self) -> bool: ...
+    @sleep.setter
+    def sleep(self, on: bool) -> None: ...
+    @property
+    def dt(self) -> float: ...
+    @dt.setter
+    def dt(self, dt: float) -> None: ...
+    @property
+    def duration(self) -> float: ...
+    @duration.setter
+    def duration(self, duration: float) -> None: ...
+    @property
+    def solver_settings(self) -> SolverSettings: ...
+    @solver_settings.setter
+    def solver_settings(self, settings: SolverSettings) -> None: ...
+    @property
+    def contact_margin(self) -> float: ...
+    def diagnostics(self) -> Diagnostics:
+        """Energies, momentum and angular momentum of the current state."""
+    def state_hash(self) -> int:
+        """Equal hashes mean bit-identical states."""

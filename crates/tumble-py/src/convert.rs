@@ -1,0 +1,136 @@
+//! Python values in, Python values out: numbers, vectors and quaternions as sequences or
+//! numpy arrays, errors as ValueError/TypeError naming the field.
+
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use tumble::{Mat3, Quat, Real, Vec3};
+
+/// A Python float as the core's number type.
+// With the default f64 build the cast is the identity; it narrows under `tumble/f32`.
+#[allow(clippy::unnecessary_cast)]
+pub fn real(x: f64) -> Real {
+    x as Real
+}
+
+/// A core number as a Python float.
+#[allow(clippy::unnecessary_cast)]
+pub fn wide(x: Real) -> f64 {
+    x as f64
+}
+
+/// The core's refusal, whose text already names the field (`shape.radius: must be > 0`).
+pub fn engine(e: tumble::Error) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+/// The scene loader's refusal, `bodies[3].shape.radius: must be > 0`.
+pub fn scene(e: tumble_scene::SceneError) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+/// A ValueError in the engine's `field: reason` form.
+pub fn invalid(field: &str, reason: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(format!("{field}: {reason}"))
+}
+
+/// A TypeError in the same form.
+pub fn wrong_type(field: &str, expected: &str, got: &Bound<'_, PyAny>) -> PyErr {
+    let type_name = got
+        .get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_else(|_| "?".into());
+    PyTypeError::new_err(format!("{field}: expected {expected}, got {type_name}"))
+}
+
+/// `n` numbers from any sequence or 1-D array.
+pub fn numbers(obj: &Bound<'_, PyAny>, field: &str, n: usize, what: &str) -> PyResult<Vec<f64>> {
+    if obj.is_instance_of::<pyo3::types::PyString>() {
+        return Err(wrong_type(field, what, obj));
+    }
+    let v: Vec<f64> = obj.extract().map_err(|_| wrong_type(field, what, obj))?;
+    if v.len() != n {
+        return Err(invalid(
+            field,
+            format!("expected {what}, got {} numbers", v.len()),
+        ));
+    }
+    Ok(v)
+}
+
+/// `[x, y, z]`.
+pub fn vec3(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<Vec3> {
+    let v = numbers(obj, field, 3, "3 numbers [x, y, z]")?;
+    Ok(Vec3::new(real(v[0]), real(v[1]), real(v[2])))
+}
+
+/// `[x, y, z]`, or `default` when not given.
+pub fn vec3_or(obj: Option<&Bound<'_, PyAny>>, field: &str, default: Vec3) -> PyResult<Vec3> {
+    obj.map_or(Ok(default), |o| vec3(o, field))
+}
+
+/// A quaternion `[x, y, z, w]`; the engine checks it is non-zero and normalises it.
+pub fn quat(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<Quat> {
+    let v = numbers(obj, field, 4, "a quaternion of 4 numbers [x, y, z, w]")?;
+    Ok(Quat::from_xyzw(
+        real(v[0]),
+        real(v[1]),
+        real(v[2]),
+        real(v[3]),
+    ))
+}
+
+/// A quaternion, or the identity when not given.
+pub fn quat_or(obj: Option<&Bound<'_, PyAny>>, field: &str) -> PyResult<Quat> {
+    obj.map_or(Ok(Quat::IDENTITY), |o| quat(o, field))
+}
+
+/// A list of points `[[x, y, z], ...]` or an (N, 3) array.
+pub fn points(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<Vec<Vec3>> {
+    let expected = "an array of points of shape (N, 3)";
+    if obj.is_instance_of::<pyo3::types::PyString>() {
+        return Err(wrong_type(field, expected, obj));
+    }
+    let rows: Vec<Bound<'_, PyAny>> = obj
+        .extract()
+        .map_err(|_| wrong_type(field, expected, obj))?;
+    rows.iter()
+        .enumerate()
+        .map(|(i, row)| vec3(row, &format!("{field}[{i}]")))
+        .collect()
+}
+
+/// A 3×3 matrix given as three rows.
+pub fn mat3_rows(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<Mat3> {
+    let rows = points(obj, field)?;
+    if rows.len() != 3 {
+        return Err(invalid(field, "expected 3 rows of 3 numbers"));
+    }
+    Ok(Mat3::from_cols(rows[0], rows[1], rows[2]).transpose())
+}
+
+/// A vector as a float64 array of shape (3,).
+pub fn vec3_out<'py>(py: Python<'py>, v: Vec3) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_vec(py, vec![wide(v.x), wide(v.y), wide(v.z)])
+}
+
+/// A quaternion as a float64 array `[x, y, z, w]`.
+pub fn quat_out<'py>(py: Python<'py>, q: Quat) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_vec(py, vec![wide(q.x), wide(q.y), wide(q.z), wide(q.w)])
+}
+
+/// A matrix as a float64 array of shape (3, 3), rows first.
+pub fn mat3_out<'py>(py: Python<'py>, m: Mat3) -> PyResult<Bound<'py, PyAny>> {
+    let rows = [m.row(0), m.row(1), m.row(2)];
+    let flat: Vec<f64> = rows
+        .iter()
+        .flat_map(|r| [wide(r.x), wide(r.y), wide(r.z)])
+        .collect();
+    Ok(PyArray1::from_vec(py, flat).reshape([3, 3])?.into_any())
+}
+
+/// The bits of a collision layer mask, checked to fit 32 bits.
+pub fn layer_bits(value: i64, field: &str) -> PyResult<u32> {
+    u32::try_from(value).map_err(|_| invalid(field, "must be a whole number in [0, 2**32)"))
+}

@@ -1,0 +1,401 @@
+//! Joints: `World.add_joint` for ball, hinge, slider, fixed and distance joints, with
+//! their limits, motors and springs, and `tumble.Joint` handles that read the reaction.
+
+use numpy::PyArray1;
+use pyo3::exceptions::{PyKeyError, PyTypeError};
+use pyo3::prelude::*;
+use tumble::{BodyId, JointDef, JointId, JointKind, Quat, Real, Vec3};
+
+use crate::body::{handle, PyBody};
+use crate::convert::{engine, invalid, numbers, real, vec3, vec3_out, wrong_type};
+use crate::world::{body_arg, Inner, PyWorld};
+
+/// A velocity motor on a hinge or slider: drive the joint at `speed` (rad/s or m/s) with
+/// at most `max_force` (N·m for hinges, N for sliders).
+#[pyclass(module = "tumble", name = "Motor", frozen, get_all)]
+pub struct PyMotor {
+    /// Target speed (rad/s for hinges, m/s for sliders).
+    speed: f64,
+    /// Largest torque (N·m) or force (N) the motor may exert.
+    max_force: f64,
+}
+
+#[pymethods]
+impl PyMotor {
+    #[new]
+    fn new(speed: f64, max_force: f64) -> Self {
+        PyMotor { speed, max_force }
+    }
+
+    fn __repr__(&self) -> String {
+        format!("tumble.Motor({}, {})", self.speed, self.max_force)
+    }
+}
+
+/// A spring on a joint's free coordinate: natural frequency `hertz` (Hz), `damping_ratio`
+/// (1 = critical) and rest angle or position `target` (rad or m; a distance joint's rest
+/// length is its `length`).
+#[pyclass(module = "tumble", name = "JointSpring", frozen, get_all)]
+pub struct PyJointSpring {
+    /// Natural frequency (Hz).
+    hertz: f64,
+    /// Damping ratio (1 = critical).
+    damping_ratio: f64,
+    /// Rest angle (rad) or position (m).
+    target: f64,
+}
+
+#[pymethods]
+impl PyJointSpring {
+    #[new]
+    #[pyo3(signature = (hertz, damping_ratio = 1.0, target = 0.0))]
+    fn new(hertz: f64, damping_ratio: f64, target: f64) -> Self {
+        PyJointSpring {
+            hertz,
+            damping_ratio,
+            target,
+        }
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "tumble.JointSpring({}, damping_ratio={}, target={})",
+            self.hertz, self.damping_ratio, self.target
+        )
+    }
+}
+
+/// A joint in a world: its `name`, `kind`, `body` and `other` (None: the world), whether it
+/// is `broken`, and the `reaction_force` (N) and `reaction_torque` (N·m) it applied to
+/// `other` over the last step (`body` felt the opposite).
+#[pyclass(module = "tumble", name = "Joint", frozen)]
+pub struct PyJoint {
+    world: Py<PyWorld>,
+    id: JointId,
+}
+
+impl PyJoint {
+    fn read<R>(&self, f: impl FnOnce(&tumble::Joint) -> R) -> PyResult<R> {
+        let g = self.world.get().lock()?;
+        Ok(f(g.world.joint(self.id).map_err(engine)?))
+    }
+}
+
+#[pymethods]
+impl PyJoint {
+    /// The joint's name, or None.
+    #[getter]
+    fn name(&self) -> PyResult<Option<String>> {
+        self.read(|j| j.name().map(str::to_string))
+    }
+
+    /// "ball", "hinge", "slider", "fixed" or "distance".
+    #[getter]
+    fn kind(&self) -> PyResult<&'static str> {
+        self.read(|j| j.kind().name())
+    }
+
+    /// The first body.
+    #[getter]
+    fn body<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBody>> {
+        let id = self.read(|j| j.body())?;
+        handle(self.world.bind(py), id)
+    }
+
+    /// The second body, or None when the joint holds `body` to the world.
+    #[getter]
+    fn other<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyBody>>> {
+        let id = self.read(|j| j.other())?;
+        id.map(|id| handle(self.world.bind(py), id)).transpose()
+    }
+
+    /// Whether the joint broke (its reaction exceeded `break_force`); a broken joint
+    /// holds nothing.
+    #[getter]
+    fn broken(&self) -> PyResult<bool> {
+        self.read(|j| j.is_broken())
+    }
+
+    /// Force the joint applied to `other` over the last step (N, world frame), array (3,);
+    /// the force on `body` is its opposite.
+    #[getter]
+    fn reaction_force<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(vec3_out(py, self.read(|j| j.reaction_force())?))
+    }
+
+    /// Torque the joint applied to `other` about its anchor over the last step (N·m, world
+    /// frame), array (3,).
+    #[getter]
+    fn reaction_torque<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(vec3_out(py, self.read(|j| j.reaction_torque())?))
+    }
+
+    /// Whether the joint still exists in its world.
+    #[getter]
+    fn alive(&self) -> PyResult<bool> {
+        Ok(self.world.get().lock()?.world.joint(self.id).is_ok())
+    }
+
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other.cast::<PyJoint>().is_ok_and(|o| {
+            let o = o.get();
+            o.id == self.id && o.world.as_ptr() == self.world.as_ptr()
+        })
+    }
+
+    fn __hash__(&self) -> u64 {
+        u64::from(self.id.0)
+    }
+
+    fn __repr__(&self) -> String {
+        match self.read(|j| (j.kind().name(), j.name().map(str::to_string))) {
+            Ok((kind, Some(name))) => format!("<tumble.Joint {kind} '{name}'>"),
+            Ok((kind, None)) => format!("<tumble.Joint {kind} #{}>", self.id.0),
+            Err(_) => "<tumble.Joint (removed)>".into(),
+        }
+    }
+}
+
+fn joint_handle<'py>(world: &Bound<'py, PyWorld>, id: JointId) -> PyResult<Bound<'py, PyJoint>> {
+    Bound::new(
+        world.py(),
+        PyJoint {
+            world: world.clone().unbind(),
+            id,
+        },
+    )
+}
+
+/// The kind-specific options; `None` where not given.
+#[derive(Default)]
+struct Options<'a, 'py> {
+    cone: Option<f64>,
+    twist: Option<&'a Bound<'py, PyAny>>,
+    limits: Option<&'a Bound<'py, PyAny>>,
+    motor: Option<&'a Bound<'py, PyAny>>,
+    spring: Option<&'a Bound<'py, PyAny>>,
+    length: Option<f64>,
+    min: Option<f64>,
+    max: Option<f64>,
+}
+
+fn range(obj: Option<&Bound<'_, PyAny>>, field: &str) -> PyResult<Option<[Real; 2]>> {
+    obj.map(|o| {
+        let v = numbers(o, field, 2, "[lower, upper]")?;
+        Ok([real(v[0]), real(v[1])])
+    })
+    .transpose()
+}
+
+fn motor(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<tumble::Motor>> {
+    obj.map(|o| {
+        let m = o
+            .cast::<PyMotor>()
+            .map_err(|_| wrong_type("motor", "a tumble.Motor(speed, max_force)", o))?;
+        let m = m.get();
+        Ok(tumble::Motor {
+            speed: real(m.speed),
+            max_force: real(m.max_force),
+        })
+    })
+    .transpose()
+}
+
+fn spring(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<tumble::JointSpring>> {
+    obj.map(|o| {
+        let s = o
+            .cast::<PyJointSpring>()
+            .map_err(|_| wrong_type("spring", "a tumble.JointSpring(hertz, ...)", o))?;
+        let s = s.get();
+        Ok(tumble::JointSpring {
+            hertz: real(s.hertz),
+            damping_ratio: real(s.damping_ratio),
+            target: real(s.target),
+        })
+    })
+    .transpose()
+}
+
+fn kind_of(name: &str, o: &Options<'_, '_>) -> PyResult<JointKind> {
+    let given = [
+        ("cone", o.cone.is_some()),
+        ("twist", o.twist.is_some()),
+        ("limits", o.limits.is_some()),
+        ("motor", o.motor.is_some()),
+        ("spring", o.spring.is_some()),
+        ("length", o.length.is_some()),
+        ("min", o.min.is_some()),
+        ("max", o.max.is_some()),
+    ];
+    let allowed: &[&str] = match name {
+        "ball" => &["cone", "twist"],
+        "hinge" | "slider" => &["limits", "motor", "spring"],
+        "fixed" => &[],
+        "distance" => &["length", "min", "max", "spring"],
+        other => {
+            return Err(invalid(
+                "kind",
+                format!(
+                    "unknown joint type '{other}' (expected one of: {})",
+                    tumble_scene::JOINT_TYPES.join(", ")
+                ),
+            ))
+        }
+    };
+    if let Some((key, _)) = given.iter().find(|(k, g)| *g && !allowed.contains(k)) {
+        return Err(PyTypeError::new_err(format!(
+            "{key}: not an option of a {name} joint (its options: {})",
+            if allowed.is_empty() {
+                "none".to_string()
+            } else {
+                allowed.join(", ")
+            }
+        )));
+    }
+    Ok(match name {
+        "ball" => JointKind::Ball {
+            cone: o.cone.map(real),
+            twist: range(o.twist, "twist")?,
+        },
+        "hinge" => JointKind::Hinge {
+            limits: range(o.limits, "limits")?,
+            motor: motor(o.motor)?,
+            spring: spring(o.spring)?,
+        },
+        "slider" => JointKind::Slider {
+            limits: range(o.limits, "limits")?,
+            motor: motor(o.motor)?,
+            spring: spring(o.spring)?,
+        },
+        "fixed" => JointKind::Fixed,
+        _ => JointKind::Distance {
+            length: o.length.map(real),
+            min: o.min.map(real),
+            max: o.max.map(real),
+            spring: spring(o.spring)?,
+        },
+    })
+}
+
+/// A body's frame (origin and rotation); the world's is the identity.
+fn frame(g: &Inner, id: Option<BodyId>) -> (Vec3, Quat) {
+    id.and_then(|id| g.world.body(id).ok())
+        .map(|b| (b.pose().position, b.pose().rotation))
+        .unwrap_or((Vec3::ZERO, Quat::IDENTITY))
+}
+
+#[pymethods]
+impl PyWorld {
+    /// Adds a joint of `kind` ("ball", "hinge", "slider", "fixed" or "distance") between
+    /// `body` and `other` (a body or name; None: the world) and returns its handle.
+    ///
+    /// `anchor` and `axis` are in `body`'s frame (m; axis default x); `other_anchor` and
+    /// `other_axis` in `other`'s frame, or world coordinates when joined to the world; left
+    /// out, they are where `body`'s anchor and axis are now, so the joint starts satisfied.
+    /// Options by kind: ball `cone` (rad) and `twist` [lo, hi] (rad); hinge and slider
+    /// `limits` [lo, hi] (rad or m), `motor` (tumble.Motor), `spring` (tumble.JointSpring);
+    /// distance `length`, `min`, `max` (m) and `spring`. `collide_connected` lets the two
+    /// bodies still collide; `break_force` (N) breaks the joint when exceeded.
+    #[pyo3(signature = (kind, body, other = None, *, anchor = None, axis = None,
+        other_anchor = None, other_axis = None, name = None, collide_connected = false,
+        break_force = None, cone = None, twist = None, limits = None, motor = None,
+        spring = None, length = None, min = None, max = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_joint<'py>(
+        slf: &Bound<'py, Self>,
+        kind: String,
+        body: &Bound<'py, PyAny>,
+        other: Option<&Bound<'py, PyAny>>,
+        anchor: Option<&Bound<'py, PyAny>>,
+        axis: Option<&Bound<'py, PyAny>>,
+        other_anchor: Option<&Bound<'py, PyAny>>,
+        other_axis: Option<&Bound<'py, PyAny>>,
+        name: Option<String>,
+        collide_connected: bool,
+        break_force: Option<f64>,
+        cone: Option<f64>,
+        twist: Option<&Bound<'py, PyAny>>,
+        limits: Option<&Bound<'py, PyAny>>,
+        motor: Option<&Bound<'py, PyAny>>,
+        spring: Option<&Bound<'py, PyAny>>,
+        length: Option<f64>,
+        min: Option<f64>,
+        max: Option<f64>,
+    ) -> PyResult<Bound<'py, PyJoint>> {
+        let options = Options {
+            cone,
+            twist,
+            limits,
+            motor,
+            spring,
+            length,
+            min,
+            max,
+        };
+        let kind = kind_of(&kind, &options)?;
+        let id = {
+            let mut g = slf.get().lock()?;
+            let a = body_arg(slf, &g, body, "body")?;
+            let b = other.map(|o| body_arg(slf, &g, o, "other")).transpose()?;
+            let anchor = anchor.map_or(Ok(Vec3::ZERO), |v| vec3(v, "anchor"))?;
+            let axis = axis.map_or(Ok(Vec3::X), |v| vec3(v, "axis"))?;
+            // As in scene files: a missing far end is where `body`'s anchor and axis are.
+            let (pa, qa) = frame(&g, Some(a));
+            let (pb, qb) = frame(&g, b);
+            let other_anchor = match other_anchor {
+                Some(v) => vec3(v, "other_anchor")?,
+                None => qb.inverse() * (pa + qa * anchor - pb),
+            };
+            let other_axis = match other_axis {
+                Some(v) => vec3(v, "other_axis")?,
+                None => qb.inverse() * (qa * axis),
+            };
+            let def = JointDef {
+                name,
+                kind,
+                body: a,
+                anchor,
+                axis,
+                other: b,
+                other_anchor,
+                other_axis,
+                collide_connected,
+                break_force: break_force.map(real),
+            };
+            g.world.create_joint(&def).map_err(engine)?
+        };
+        joint_handle(slf, id)
+    }
+
+    /// Removes a joint, waking the bodies it held; False if it was already gone.
+    fn remove_joint(&self, joint: &Bound<'_, PyAny>) -> PyResult<bool> {
+        let j = joint
+            .cast::<PyJoint>()
+            .map_err(|_| wrong_type("joint", "a tumble.Joint", joint))?;
+        let id = j.get().id;
+        Ok(self.lock()?.world.remove_joint(id))
+    }
+
+    /// The joint called `name` (KeyError if there is none).
+    fn joint<'py>(slf: &Bound<'py, Self>, name: String) -> PyResult<Bound<'py, PyJoint>> {
+        let id = slf.get().lock()?.world.find_joint(&name);
+        match id {
+            Some(id) => joint_handle(slf, id),
+            None => Err(PyKeyError::new_err(format!("no joint named '{name}'"))),
+        }
+    }
+
+    /// Every joint's handle, in creation order.
+    #[getter]
+    fn joints<'py>(slf: &Bound<'py, Self>) -> PyResult<Vec<Bound<'py, PyJoint>>> {
+        let ids: Vec<JointId> = slf.get().lock()?.world.joints().map(|(id, _)| id).collect();
+        ids.into_iter().map(|id| joint_handle(slf, id)).collect()
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyMotor>()?;
+    m.add_class::<PyJointSpring>()?;
+    m.add_class::<PyJoint>()?;
+    Ok(())
+}

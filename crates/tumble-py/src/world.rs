@@ -1,0 +1,703 @@
+//! `tumble.World`: construction (keywords or a scene file), bodies, force elements,
+//! stepping, settings and diagnostics.
+
+use std::sync::{Mutex, MutexGuard, TryLockError};
+
+use numpy::PyArray1;
+use pyo3::exceptions::{PyKeyError, PyRuntimeError};
+use pyo3::prelude::*;
+use tumble::{
+    AppliedForce, BodyDef, BodyId, BodyKind, Drag, Force, ForceId, InertiaSpec, MassSpec, Real,
+    SolverSettings, Spring, SpringEnd, Vec3, World, WorldDef,
+};
+
+use crate::body::{handle, PyBody};
+use crate::convert::{
+    engine, invalid, layer_bits, mat3_rows, numbers, quat_or, real, scene, vec3, vec3_or, vec3_out,
+    wide, wrong_type,
+};
+use crate::shapes::shape_of;
+
+/// The world and the run settings a scene file brings along.
+pub struct Inner {
+    pub world: World,
+    /// Default step of `simulate` (s): the scene's `dt`, else 0.01.
+    pub dt: Real,
+    /// Default length of `simulate` (s): the scene's `duration`, else 1.
+    pub duration: Real,
+}
+
+/// A simulated world: bodies, force elements, joints, and the step that advances them.
+///
+/// World(*, gravity=(0, -9.8, 0), integrator="symplectic_euler", solver="soft_step",
+/// substeps=4, iterations=1, contact_hertz=60.0, contact_damping_ratio=10.0,
+/// joint_hertz=1000.0, joint_damping_ratio=0.5, baumgarte=0.2, length_unit=1.0,
+/// sleep=True). SI units throughout; quaternions are [x, y, z, w].
+#[pyclass(module = "tumble", name = "World", frozen)]
+pub struct PyWorld {
+    // A Mutex rather than PyO3's borrow flag: the engine's World is Send but not Sync
+    // (it owns FnMut force callbacks), and a frozen class over a Mutex is Sync. The lock
+    // is only ever tried, never waited for, so a thread holding the interpreter cannot
+    // deadlock against one stepping without it.
+    inner: Mutex<Inner>,
+}
+
+impl PyWorld {
+    pub fn new_inner(inner: Inner) -> PyWorld {
+        PyWorld {
+            inner: Mutex::new(inner),
+        }
+    }
+
+    /// The world, or a RuntimeError while another thread is stepping it.
+    pub fn lock(&self) -> PyResult<MutexGuard<'_, Inner>> {
+        match self.inner.try_lock() {
+            Ok(guard) => Ok(guard),
+            // The engine does not panic on input; if something did, the state it left is
+            // still a valid world (every edit is checked before it is made).
+            Err(TryLockError::Poisoned(p)) => Ok(p.into_inner()),
+            Err(TryLockError::WouldBlock) => Err(PyRuntimeError::new_err(
+                "the world is busy: another thread is stepping or simulating it",
+            )),
+        }
+    }
+}
+
+/// A body argument: a `tumble.Body` of this world, or a body's name.
+pub fn body_arg(
+    world: &Bound<'_, PyWorld>,
+    inner: &Inner,
+    obj: &Bound<'_, PyAny>,
+    field: &str,
+) -> PyResult<BodyId> {
+    if let Ok(b) = obj.cast::<PyBody>() {
+        let b = b.get();
+        if b.world.as_ptr() != world.as_ptr() {
+            return Err(invalid(field, "this body belongs to another world"));
+        }
+        inner
+            .world
+            .body(b.id)
+            .map_err(|_| invalid(field, "this body was removed"))?;
+        return Ok(b.id);
+    }
+    if let Ok(name) = obj.extract::<String>() {
+        return inner
+            .world
+            .find_body(&name)
+            .ok_or_else(|| invalid(field, format!("no body named '{name}'")));
+    }
+    Err(wrong_type(field, "a tumble.Body or a body's name", obj))
+}
+
+/// A count such as `substeps`, at least 1.
+fn count(value: i64, field: &str) -> PyResult<u32> {
+    u32::try_from(value)
+        .ok()
+        .filter(|&v| v >= 1)
+        .ok_or_else(|| invalid(field, "must be >= 1"))
+}
+
+/// Solver settings: `kind` ("soft_step" or "pgs"), `substeps` and `iterations` per step,
+/// contact stiffness `contact_hertz` (Hz) and `contact_damping_ratio`, `baumgarte` (PGS's
+/// fraction of error corrected per substep), and the joints' `joint_hertz` (Hz) and
+/// `joint_damping_ratio`. Read with `world.solver_settings`, change a copy, assign it back.
+#[pyclass(module = "tumble", name = "SolverSettings", get_all, set_all)]
+#[derive(Clone)]
+pub struct PySolverSettings {
+    /// "soft_step" or "pgs".
+    kind: String,
+    /// Solver substeps per step (>= 1).
+    substeps: i64,
+    /// Solve (and relax) passes per substep (>= 1).
+    iterations: i64,
+    /// Contact stiffness (Hz), capped at a quarter of the substep rate.
+    contact_hertz: f64,
+    /// Damping ratio of the contact spring.
+    contact_damping_ratio: f64,
+    /// PGS's fraction of the position error corrected per substep.
+    baumgarte: f64,
+    /// Stiffness of the joints' drift correction (Hz).
+    joint_hertz: f64,
+    /// Damping ratio of the joints' drift correction.
+    joint_damping_ratio: f64,
+}
+
+impl PySolverSettings {
+    fn of(s: &SolverSettings) -> Self {
+        PySolverSettings {
+            kind: s.kind.name().to_string(),
+            substeps: i64::from(s.substeps),
+            iterations: i64::from(s.iterations),
+            contact_hertz: wide(s.contact_hertz),
+            contact_damping_ratio: wide(s.contact_damping_ratio),
+            baumgarte: wide(s.baumgarte),
+            joint_hertz: wide(s.joint_hertz),
+            joint_damping_ratio: wide(s.joint_damping_ratio),
+        }
+    }
+
+    fn to_core(&self) -> PyResult<SolverSettings> {
+        Ok(SolverSettings {
+            kind: tumble_scene::parse_solver(&self.kind).map_err(scene)?,
+            substeps: count(self.substeps, "substeps")?,
+            iterations: count(self.iterations, "iterations")?,
+            contact_hertz: real(self.contact_hertz),
+            contact_damping_ratio: real(self.contact_damping_ratio),
+            baumgarte: real(self.baumgarte),
+            joint_hertz: real(self.joint_hertz),
+            joint_damping_ratio: real(self.joint_damping_ratio),
+        })
+    }
+}
+
+#[pymethods]
+impl PySolverSettings {
+    #[new]
+    #[pyo3(signature = (*, kind = "soft_step".to_string(), substeps = 4, iterations = 1,
+        contact_hertz = 60.0, contact_damping_ratio = 10.0, baumgarte = 0.2,
+        joint_hertz = 1000.0, joint_damping_ratio = 0.5))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        kind: String,
+        substeps: i64,
+        iterations: i64,
+        contact_hertz: f64,
+        contact_damping_ratio: f64,
+        baumgarte: f64,
+        joint_hertz: f64,
+        joint_damping_ratio: f64,
+    ) -> PyResult<Self> {
+        let s = PySolverSettings {
+            kind,
+            substeps,
+            iterations,
+            contact_hertz,
+            contact_damping_ratio,
+            baumgarte,
+            joint_hertz,
+            joint_damping_ratio,
+        };
+        s.to_core()?;
+        Ok(s)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "tumble.SolverSettings(kind={:?}, substeps={}, iterations={}, contact_hertz={}, \
+             contact_damping_ratio={}, baumgarte={}, joint_hertz={}, joint_damping_ratio={})",
+            self.kind,
+            self.substeps,
+            self.iterations,
+            self.contact_hertz,
+            self.contact_damping_ratio,
+            self.baumgarte,
+            self.joint_hertz,
+            self.joint_damping_ratio
+        )
+    }
+}
+
+/// Energies and momenta of a state, over the dynamic bodies: `kinetic`, `potential`
+/// (gravity, zero at the origin, plus springs) and `total` in J; `linear_momentum`
+/// (kg·m/s) and `angular_momentum` about the world origin (kg·m²/s) as arrays (3,).
+#[pyclass(module = "tumble", name = "Diagnostics", frozen, get_all)]
+pub struct PyDiagnostics {
+    /// Kinetic energy (J).
+    kinetic: f64,
+    /// Potential energy (J): gravity, zero at the origin, plus springs.
+    potential: f64,
+    /// Kinetic plus potential (J).
+    total: f64,
+    /// Linear momentum (kg·m/s), (3,).
+    linear_momentum: Py<PyArray1<f64>>,
+    /// Angular momentum about the world origin (kg·m²/s), (3,).
+    angular_momentum: Py<PyArray1<f64>>,
+}
+
+#[pymethods]
+impl PyDiagnostics {
+    fn __repr__(&self) -> String {
+        format!(
+            "tumble.Diagnostics(kinetic={}, potential={}, total={}, ...)",
+            self.kinetic, self.potential, self.total
+        )
+    }
+}
+
+fn spring_end(
+    slf: &Bound<'_, PyWorld>,
+    g: &Inner,
+    body: BodyId,
+    world_point: Option<&Bound<'_, PyAny>>,
+    other: Option<&Bound<'_, PyAny>>,
+    other_anchor: Option<&Bound<'_, PyAny>>,
+) -> PyResult<SpringEnd> {
+    match (world_point, other) {
+        (Some(p), None) => {
+            if other_anchor.is_some() {
+                return Err(invalid("other_anchor", "only with other"));
+            }
+            Ok(SpringEnd::World(vec3(p, "world_point")?))
+        }
+        (None, Some(o)) => {
+            let id = body_arg(slf, g, o, "other")?;
+            if id == body {
+                return Err(invalid("other", "must be a different body than body"));
+            }
+            Ok(SpringEnd::Body {
+                body: id,
+                anchor: vec3_or(other_anchor, "other_anchor", Vec3::ZERO)?,
+            })
+        }
+        (Some(_), Some(_)) => Err(invalid(
+            "other",
+            "cannot be given together with world_point (give exactly one of world_point, other)",
+        )),
+        (None, None) => Err(invalid(
+            "world_point",
+            "a spring needs world_point or other (give exactly one)",
+        )),
+    }
+}
+
+#[pymethods]
+impl PyWorld {
+    #[new]
+    #[pyo3(signature = (*, gravity = None, integrator = "symplectic_euler".to_string(),
+        solver = "soft_step".to_string(), substeps = 4, iterations = 1, contact_hertz = 60.0,
+        contact_damping_ratio = 10.0, joint_hertz = 1000.0, joint_damping_ratio = 0.5,
+        baumgarte = 0.2, length_unit = 1.0, sleep = true))]
+    #[allow(clippy::too_many_arguments)]
+    fn py_new(
+        gravity: Option<&Bound<'_, PyAny>>,
+        integrator: String,
+        solver: String,
+        substeps: i64,
+        iterations: i64,
+        contact_hertz: f64,
+        contact_damping_ratio: f64,
+        joint_hertz: f64,
+        joint_damping_ratio: f64,
+        baumgarte: f64,
+        length_unit: f64,
+        sleep: bool,
+    ) -> PyResult<Self> {
+        let settings = PySolverSettings {
+            kind: solver,
+            substeps,
+            iterations,
+            contact_hertz,
+            contact_damping_ratio,
+            baumgarte,
+            joint_hertz,
+            joint_damping_ratio,
+        };
+        let def = WorldDef {
+            gravity: vec3_or(gravity, "gravity", Vec3::new(0.0, -9.8, 0.0))?,
+            integrator: tumble_scene::parse_integrator(&integrator).map_err(scene)?,
+            length_unit: real(length_unit),
+            solver: settings.to_core()?,
+            sleep,
+        };
+        let world = World::try_new(&def).map_err(engine)?;
+        Ok(PyWorld::new_inner(Inner {
+            world,
+            dt: tumble_scene::DEFAULT_DT,
+            duration: tumble_scene::DEFAULT_DURATION,
+        }))
+    }
+
+    /// Loads a scene: a file path or a built-in scene's name (see `tumble.SCENES`). The
+    /// scene's `dt` and `duration` become `simulate`'s defaults. Bad scenes raise
+    /// ValueError naming the field, e.g. `bodies[3].shape.radius: must be > 0`.
+    #[staticmethod]
+    fn from_scene(path: std::path::PathBuf) -> PyResult<Self> {
+        let text = path.to_string_lossy().into_owned();
+        let s = tumble_scene::load(&text).map_err(scene)?;
+        Ok(PyWorld::new_inner(Inner {
+            world: s.world,
+            dt: s.dt,
+            duration: s.duration,
+        }))
+    }
+
+    /// Loads a scene from JSON text (docs/scene-format.md).
+    #[staticmethod]
+    fn from_json(text: String) -> PyResult<Self> {
+        let s = tumble_scene::load_str(&text).map_err(scene)?;
+        Ok(PyWorld::new_inner(Inner {
+            world: s.world,
+            dt: s.dt,
+            duration: s.duration,
+        }))
+    }
+
+    /// Adds a body and returns its handle.
+    ///
+    /// `mass` (kg) or `density` (kg/m³, default 1000) but not both; `position` (m) of the
+    /// body frame's origin; `orientation` [x, y, z, w]; `velocity` (m/s) of the centre of
+    /// mass and `angular_velocity` (rad/s), world frame; `kind` "dynamic", "kinematic" or
+    /// "static"; `inertia` as 3 principal moments or a 3×3 matrix (kg·m², body axes) and
+    /// `center_of_mass` (m, body frame) override the shape's; `planar` confines the body
+    /// to the xy plane; `friction`, `restitution`, `collision_group`/`collision_mask`
+    /// (32-bit layer sets) and `bullet` (continuous collision against every body).
+    #[pyo3(signature = (shape, *, mass = None, density = None, position = None,
+        orientation = None, velocity = None, angular_velocity = None,
+        kind = "dynamic".to_string(), name = None, planar = false, inertia = None,
+        center_of_mass = None, friction = 0.6, restitution = 0.0, collision_group = 1,
+        collision_mask = 0xFFFF_FFFF, bullet = false))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_body<'py>(
+        slf: &Bound<'py, Self>,
+        shape: &Bound<'py, PyAny>,
+        mass: Option<f64>,
+        density: Option<f64>,
+        position: Option<&Bound<'py, PyAny>>,
+        orientation: Option<&Bound<'py, PyAny>>,
+        velocity: Option<&Bound<'py, PyAny>>,
+        angular_velocity: Option<&Bound<'py, PyAny>>,
+        kind: String,
+        name: Option<String>,
+        planar: bool,
+        inertia: Option<&Bound<'py, PyAny>>,
+        center_of_mass: Option<&Bound<'py, PyAny>>,
+        friction: f64,
+        restitution: f64,
+        collision_group: i64,
+        collision_mask: i64,
+        bullet: bool,
+    ) -> PyResult<Bound<'py, PyBody>> {
+        let shape = shape_of(shape, "shape")?;
+        let mass = match (mass, density) {
+            (Some(_), Some(_)) => {
+                return Err(invalid(
+                    "density",
+                    "cannot be given together with mass (give one of mass, density)",
+                ))
+            }
+            (Some(m), None) => MassSpec::Mass(real(m)),
+            (None, Some(d)) => MassSpec::Density(real(d)),
+            (None, None) => MassSpec::default(),
+        };
+        let kind = BodyKind::from_name(&kind).ok_or_else(|| {
+            invalid(
+                "kind",
+                format!("unknown body kind '{kind}' (expected one of: static, kinematic, dynamic)"),
+            )
+        })?;
+        let inertia = inertia.map(inertia_spec).transpose()?;
+        let def = BodyDef {
+            name,
+            kind,
+            position: vec3_or(position, "position", Vec3::ZERO)?,
+            orientation: quat_or(orientation, "orientation")?,
+            linear_velocity: vec3_or(velocity, "velocity", Vec3::ZERO)?,
+            angular_velocity: vec3_or(angular_velocity, "angular_velocity", Vec3::ZERO)?,
+            mass,
+            inertia,
+            center_of_mass: center_of_mass
+                .map(|c| vec3(c, "center_of_mass"))
+                .transpose()?,
+            planar,
+            collision_group: layer_bits(collision_group, "collision_group")?,
+            collision_mask: layer_bits(collision_mask, "collision_mask")?,
+            friction: real(friction),
+            restitution: real(restitution),
+            bullet,
+        };
+        let id = slf
+            .get()
+            .lock()?
+            .world
+            .create_body(&def, shape)
+            .map_err(engine)?;
+        handle(slf, id)
+    }
+
+    /// Removes a body (a handle or a name) with every force element and joint on it.
+    fn remove_body(slf: &Bound<'_, Self>, body: &Bound<'_, PyAny>) -> PyResult<()> {
+        let mut g = slf.get().lock()?;
+        let id = body_arg(slf, &g, body, "body")?;
+        g.world.remove_body(id).map_err(engine)
+    }
+
+    /// The body called `name` (KeyError if there is none).
+    fn body<'py>(slf: &Bound<'py, Self>, name: String) -> PyResult<Bound<'py, PyBody>> {
+        let id = slf.get().lock()?.world.find_body(&name);
+        match id {
+            Some(id) => handle(slf, id),
+            None => Err(PyKeyError::new_err(format!("no body named '{name}'"))),
+        }
+    }
+
+    /// Every body's handle, in creation order (the order of the bulk arrays).
+    #[getter]
+    fn bodies<'py>(slf: &Bound<'py, Self>) -> PyResult<Vec<Bound<'py, PyBody>>> {
+        let ids = slf.get().lock()?.world.body_ids().to_vec();
+        ids.into_iter().map(|id| handle(slf, id)).collect()
+    }
+
+    /// Every body's name (None for unnamed bodies), in creation order.
+    #[getter]
+    fn body_names(&self) -> PyResult<Vec<Option<String>>> {
+        let g = self.lock()?;
+        Ok(g.world
+            .bodies()
+            .map(|(_, b)| b.name().map(str::to_string))
+            .collect())
+    }
+
+    fn __len__(&self) -> PyResult<usize> {
+        Ok(self.lock()?.world.body_count())
+    }
+
+    /// Adds a Hookean spring with a parallel damper from `anchor` on `body` (m, its frame)
+    /// to a fixed `world_point` (m) or to `other_anchor` on `other` (give exactly one of
+    /// world_point and other). `stiffness` (N/m), `rest_length` (m), `damping` (N·s/m).
+    /// Returns the force element's id.
+    #[pyo3(signature = (body, *, stiffness, world_point = None, other = None, anchor = None,
+        other_anchor = None, rest_length = 0.0, damping = 0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_spring(
+        slf: &Bound<'_, Self>,
+        body: &Bound<'_, PyAny>,
+        stiffness: f64,
+        world_point: Option<&Bound<'_, PyAny>>,
+        other: Option<&Bound<'_, PyAny>>,
+        anchor: Option<&Bound<'_, PyAny>>,
+        other_anchor: Option<&Bound<'_, PyAny>>,
+        rest_length: f64,
+        damping: f64,
+    ) -> PyResult<u32> {
+        let mut g = slf.get().lock()?;
+        let id = body_arg(slf, &g, body, "body")?;
+        let end = spring_end(slf, &g, id, world_point, other, other_anchor)?;
+        let spring = Spring {
+            body: id,
+            anchor: vec3_or(anchor, "anchor", Vec3::ZERO)?,
+            other: end,
+            stiffness: real(stiffness),
+            rest_length: real(rest_length),
+            damping: real(damping),
+        };
+        add(&mut g.world, Force::Spring(spring))
+    }
+
+    /// Adds air drag at `body`'s centre of mass: F = −linear·v − quadratic·|v|·v, with
+    /// `linear` in N·s/m and `quadratic` in N·s²/m². Returns the force element's id.
+    #[pyo3(signature = (body, *, linear = 0.0, quadratic = 0.0))]
+    fn add_drag(
+        slf: &Bound<'_, Self>,
+        body: &Bound<'_, PyAny>,
+        linear: f64,
+        quadratic: f64,
+    ) -> PyResult<u32> {
+        let mut g = slf.get().lock()?;
+        let id = body_arg(slf, &g, body, "body")?;
+        let drag = Drag {
+            body: id,
+            linear: real(linear),
+            quadratic: real(quadratic),
+        };
+        add(&mut g.world, Force::Drag(drag))
+    }
+
+    /// Adds a constant `force` (N, world frame) acting at `point` (m, body frame; default
+    /// the centre of mass) and a constant `torque` (N·m, world frame). Returns its id.
+    #[pyo3(signature = (body, *, force = None, point = None, torque = None))]
+    fn add_force(
+        slf: &Bound<'_, Self>,
+        body: &Bound<'_, PyAny>,
+        force: Option<&Bound<'_, PyAny>>,
+        point: Option<&Bound<'_, PyAny>>,
+        torque: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<u32> {
+        let mut g = slf.get().lock()?;
+        let id = body_arg(slf, &g, body, "body")?;
+        let applied = AppliedForce {
+            body: id,
+            force: vec3_or(force, "force", Vec3::ZERO)?,
+            point: point.map(|p| vec3(p, "point")).transpose()?,
+            torque: vec3_or(torque, "torque", Vec3::ZERO)?,
+        };
+        add(&mut g.world, Force::Applied(applied))
+    }
+
+    /// Removes a force element by the id its `add_*` returned; False if there is none.
+    fn remove_force(&self, id: u32) -> PyResult<bool> {
+        Ok(self.lock()?.world.remove_force(ForceId(id)))
+    }
+
+    /// Advances the world by `dt` seconds, `steps` times (default once). Long runs release
+    /// the interpreter lock, so other Python threads go on meanwhile.
+    #[pyo3(signature = (dt, steps = 1))]
+    fn step(&self, py: Python<'_>, dt: f64, steps: u64) -> PyResult<()> {
+        let mut g = self.lock()?;
+        let world = &mut g.world;
+        let dt = real(dt);
+        // Releasing and retaking the interpreter lock costs about what stepping an empty
+        // world does, so a short step keeps it.
+        let result = if (world.body_count() as u64).saturating_mul(steps) >= 64 {
+            py.detach(|| step_n(world, dt, steps))
+        } else {
+            step_n(world, dt, steps)
+        };
+        result.map_err(engine)
+    }
+
+    /// Simulated time (s).
+    #[getter]
+    fn time(&self) -> PyResult<f64> {
+        Ok(wide(self.lock()?.world.time()))
+    }
+
+    /// Steps taken so far.
+    #[getter]
+    fn step_count(&self) -> PyResult<u64> {
+        Ok(self.lock()?.world.step_count())
+    }
+
+    /// Gravitational acceleration (m/s²), an array (3,); assignable.
+    #[getter]
+    fn gravity<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(vec3_out(py, self.lock()?.world.gravity()))
+    }
+
+    #[setter]
+    fn set_gravity(&self, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        let g = vec3(value, "gravity")?;
+        self.lock()?.world.set_gravity(g).map_err(engine)
+    }
+
+    /// The integrator's name (one of `tumble.INTEGRATORS`); assignable.
+    #[getter]
+    fn integrator(&self) -> PyResult<&'static str> {
+        Ok(self.lock()?.world.integrator().name())
+    }
+
+    #[setter]
+    fn set_integrator(&self, name: String) -> PyResult<()> {
+        let i = tumble_scene::parse_integrator(&name).map_err(scene)?;
+        self.lock()?.world.set_integrator(i);
+        Ok(())
+    }
+
+    /// Whether resting islands may fall asleep; assignable (False wakes every body).
+    #[getter]
+    fn sleep(&self) -> PyResult<bool> {
+        Ok(self.lock()?.world.sleep_enabled())
+    }
+
+    #[setter]
+    fn set_sleep(&self, on: bool) -> PyResult<()> {
+        self.lock()?.world.set_sleep_enabled(on);
+        Ok(())
+    }
+
+    /// The default step of `simulate` (s): the scene's `dt`, else 0.01; assignable.
+    #[getter]
+    fn dt(&self) -> PyResult<f64> {
+        Ok(wide(self.lock()?.dt))
+    }
+
+    #[setter]
+    fn set_dt(&self, dt: f64) -> PyResult<()> {
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(invalid("dt", "must be > 0"));
+        }
+        self.lock()?.dt = real(dt);
+        Ok(())
+    }
+
+    /// The default length of `simulate` (s): the scene's `duration`, else 1; assignable.
+    #[getter]
+    fn duration(&self) -> PyResult<f64> {
+        Ok(wide(self.lock()?.duration))
+    }
+
+    #[setter]
+    fn set_duration(&self, duration: f64) -> PyResult<()> {
+        if !(duration >= 0.0 && duration.is_finite()) {
+            return Err(invalid("duration", "must be >= 0"));
+        }
+        self.lock()?.duration = real(duration);
+        Ok(())
+    }
+
+    /// A copy of the contact and joint solver's settings; assign a changed copy back.
+    #[getter]
+    fn solver_settings(&self) -> PyResult<PySolverSettings> {
+        Ok(PySolverSettings::of(&self.lock()?.world.solver_settings()))
+    }
+
+    #[setter]
+    fn set_solver_settings(&self, settings: PyRef<'_, PySolverSettings>) -> PyResult<()> {
+        let s = settings.to_core()?;
+        self.lock()?.world.set_solver_settings(s).map_err(engine)
+    }
+
+    /// Speculative contact distance (m): gaps narrower than this count as contacts.
+    #[getter]
+    fn contact_margin(&self) -> PyResult<f64> {
+        Ok(wide(self.lock()?.world.contact_margin()))
+    }
+
+    /// Energies, momentum and angular momentum of the current state.
+    fn diagnostics(&self, py: Python<'_>) -> PyResult<PyDiagnostics> {
+        let d = self.lock()?.world.diagnostics();
+        Ok(PyDiagnostics {
+            kinetic: wide(d.kinetic),
+            potential: wide(d.potential),
+            total: wide(d.total),
+            linear_momentum: vec3_out(py, d.linear_momentum).unbind(),
+            angular_momentum: vec3_out(py, d.angular_momentum).unbind(),
+        })
+    }
+
+    /// A hash of every body's state bits: equal hashes mean bit-identical states.
+    fn state_hash(&self) -> PyResult<u64> {
+        Ok(self.lock()?.world.state_hash())
+    }
+
+    fn __repr__(&self) -> PyResult<String> {
+        let g = self.lock()?;
+        Ok(format!(
+            "<tumble.World: {} bodies, t = {} s, {}>",
+            g.world.body_count(),
+            g.world.time(),
+            g.world.integrator().name()
+        ))
+    }
+}
+
+fn inertia_spec(obj: &Bound<'_, PyAny>) -> PyResult<InertiaSpec> {
+    if obj.extract::<Vec<f64>>().is_ok() {
+        let v = numbers(obj, "inertia", 3, "3 principal moments")?;
+        return Ok(InertiaSpec::Principal(Vec3::new(
+            real(v[0]),
+            real(v[1]),
+            real(v[2]),
+        )));
+    }
+    mat3_rows(obj, "inertia").map(InertiaSpec::Tensor)
+}
+
+fn add(world: &mut World, force: Force) -> PyResult<u32> {
+    world.add_force(force).map(|id| id.0).map_err(engine)
+}
+
+/// `steps` steps of `dt`, stopping at the first refusal.
+pub fn step_n(world: &mut World, dt: Real, steps: u64) -> tumble::Result<()> {
+    for _ in 0..steps {
+        world.step(dt)?;
+    }
+    Ok(())
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyWorld>()?;
+    m.add_class::<PySolverSettings>()?;
+    m.add_class::<PyDiagnostics>()?;
+    Ok(())
+}
