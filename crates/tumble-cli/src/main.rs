@@ -6,9 +6,12 @@
 
 mod analyze;
 mod contacts;
+mod progress;
 mod record;
+mod render;
 mod report;
 mod run;
+mod sample;
 
 use std::io::{self, Write};
 use std::process::ExitCode;
@@ -52,6 +55,11 @@ enum Command {
     /// body_a,body_b,x,y,z,nx,ny,nz,separation (normal from body_a to body_b, separation
     /// in m, negative when penetrating; x,y,z midway between the two surfaces).
     Contacts(contacts::ContactsArgs),
+    /// Draw a run as pictures, with no display and no GPU: an animated GIF, one PNG, a
+    /// folder of numbered PNG frames, or an MP4 (with ffmpeg). Every body drawn solid and
+    /// shaded in its own colour (or the scene's `color`), planes as a ground grid, the
+    /// time in the top-left corner.
+    Render(render::RenderArgs),
 }
 
 /// Why the program stops early.
@@ -89,6 +97,7 @@ fn main() -> ExitCode {
         Command::Analyze => analyze::analyze(),
         Command::Scenes => report::list_scenes(),
         Command::Contacts(args) => contacts::contacts(&args),
+        Command::Render(args) => render::render(&args),
     };
     match result {
         Ok(()) | Err(Failure::Closed) => ExitCode::SUCCESS,

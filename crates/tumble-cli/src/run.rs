@@ -78,7 +78,8 @@ pub struct RunArgs {
     #[arg(long, value_name = "K", default_value_t = 1)]
     pub every: u64,
 
-    /// Print nothing on standard output (errors still go to standard error).
+    /// Print nothing on standard output and show no progress bar (errors still go to
+    /// standard error).
     #[arg(long, short)]
     pub quiet: bool,
 }
@@ -120,7 +121,15 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
     apply_solver_options(args, &mut scene.world)?;
     let plan = plan(args, &scene)?;
     let mut sinks = Sinks::open(args, &scene, &plan)?;
-    step_all(&mut scene.world, &plan, args.every, &mut sinks)?;
+    let mut progress = crate::progress::Progress::new(plan.steps, "running", args.quiet);
+    step_all(
+        &mut scene.world,
+        &plan,
+        args.every,
+        &mut sinks,
+        &mut progress,
+    )?;
+    progress.finish();
     sinks.finish(&scene, &plan)
 }
 
@@ -153,6 +162,7 @@ fn step_all(
     plan: &RunPlan,
     every: u64,
     sinks: &mut Sinks,
+    progress: &mut crate::progress::Progress,
 ) -> Result<(), Failure> {
     sinks.observe(0, 0.0, world, true)?;
     for k in 1..=plan.steps {
@@ -161,6 +171,7 @@ fn step_all(
             .map_err(|e| Failure::Runtime(format!("step {k}: {e}")))?;
         let record = k % every == 0 || k == plan.steps;
         sinks.observe(k, plan.time_after(k), world, record)?;
+        progress.inc(1);
     }
     Ok(())
 }

@@ -1,0 +1,210 @@
+//! `tumble render`, `plot` and `analyze --plot` end to end: the pictures are read back and
+//! checked pixel by pixel.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use tumble_render::encode::read_png;
+
+fn tumble(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tumble"))
+        .args(args)
+        .output()
+        .expect("tumble starts")
+}
+
+fn ok(args: &[&str]) -> String {
+    let out = tumble(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "tumble {args:?}: {err}");
+    // Not a terminal here: no progress bar, nothing on stderr.
+    assert!(err.is_empty(), "stderr: {err}");
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn refused(args: &[&str]) -> String {
+    let out = tumble(args);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(2), "tumble {args:?}: {err}");
+    assert_eq!(err.lines().count(), 1, "not one line: {err:?}");
+    err.trim_end().to_string()
+}
+
+fn scratch(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tumble-visual-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// A red ball dropped from 2 m above a ground plane.
+const FALLING: &str = r##"{"dt": 0.01, "duration": 0.5, "bodies": [
+  {"name": "ground", "kind": "static", "shape": {"type": "plane", "normal": [0, 1, 0]}},
+  {"name": "ball", "color": "#ff0000", "shape": {"type": "sphere", "radius": 0.25}, "position": [0, 2, 0]}
+]}"##;
+
+fn red_rows(rgba: &[u8], width: u32) -> (f64, usize) {
+    let (mut sum, mut n) = (0.0, 0);
+    for (i, p) in rgba.chunks(4).enumerate() {
+        if p[0] > 50 && p[1] < 30 && p[2] < 30 {
+            sum += (i / width as usize) as f64;
+            n += 1;
+        }
+    }
+    (sum / n.max(1) as f64, n)
+}
+
+#[test]
+fn render_to_a_folder_shows_the_ball_falling_frame_by_frame() {
+    let dir = scratch("frames");
+    let scene = dir.join("falling.json");
+    std::fs::write(&scene, FALLING).unwrap();
+    let frames = dir.join("frames");
+    let said = ok(&[
+        "render",
+        s(&scene),
+        "--out",
+        s(&frames),
+        "--fps",
+        "10",
+        "--width",
+        "96",
+        "--height",
+        "72",
+        "--camera",
+        "0,1.5,6",
+        "--target",
+        "0,1,0",
+    ]);
+    assert!(said.contains("(6 frames, 96x72 px)"), "{said}");
+    let mut last = f64::NEG_INFINITY;
+    for k in 0..6 {
+        let (w, h, rgba) = read_png(&frames.join(format!("frame_{k:05}.png"))).unwrap();
+        assert_eq!((w, h), (96, 72));
+        let (y, n) = red_rows(&rgba, w);
+        assert!(n > 20, "frame {k}: {n} red pixels");
+        assert!(y > last, "frame {k}: red centroid row {y} not below {last}");
+        last = y;
+        // The top corners are background, the bottom ones ground: neither red.
+        assert_eq!(&rgba[..3], &tumble_render::BACKGROUND.0);
+    }
+    assert!(!frames.join("frame_00006.png").exists());
+}
+
+#[test]
+fn render_gif_and_png() {
+    let dir = scratch("gif");
+    let gif_path = dir.join("ff.gif");
+    ok(&[
+        "render",
+        "free_fall",
+        "--out",
+        s(&gif_path),
+        "--duration",
+        "0.3",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "-q",
+    ]);
+    let mut options = gif::DecodeOptions::new();
+    options.set_color_output(gif::ColorOutput::RGBA);
+    let mut decoder = options
+        .read_info(std::fs::File::open(&gif_path).unwrap())
+        .unwrap();
+    let mut frames = 0;
+    let mut coloured = Vec::new();
+    while let Some(frame) = decoder.read_next_frame().unwrap() {
+        assert_eq!((frame.width, frame.height), (64, 48));
+        frames += 1;
+        // The ball is the only saturated thing in the picture.
+        coloured.push(
+            frame
+                .buffer
+                .chunks(4)
+                .filter(|p| p[0].abs_diff(p[2]) > 60)
+                .count(),
+        );
+    }
+    assert_eq!(frames, 10, "0.3 s at 30 fps: frames at 0, 1/30, ..., 0.3 s");
+    assert!(coloured.iter().all(|n| *n > 3), "{coloured:?}");
+
+    let png = dir.join("last.png");
+    let said = ok(&[
+        "render",
+        "resting",
+        "--out",
+        s(&png),
+        "--duration",
+        "0",
+        "--width",
+        "80",
+        "--height",
+        "60",
+        "--contacts",
+        "--joints",
+    ]);
+    assert!(said.contains("1 picture"), "{said}");
+    let (w, h, rgba) = read_png(&png).unwrap();
+    assert_eq!((w, h, rgba.len()), (80, 60, 80 * 60 * 4));
+}
+
+#[test]
+fn render_refuses_bad_options_in_one_line() {
+    let dir = scratch("refusals");
+    let out = dir.join("a.gif");
+    let out = s(&out);
+    assert!(refused(&["render", "free_fall", "--out", "x.bmp"])
+        .starts_with("out: unknown picture format '.bmp'"));
+    assert!(
+        refused(&["render", "free_fall", "--out", out, "--camera", "1,2"])
+            .starts_with("camera: expected three numbers")
+    );
+    assert!(
+        refused(&["render", "free_fall", "--out", out, "--target", "a,b,c"])
+            .starts_with("target: ")
+    );
+    assert!(refused(&[
+        "render",
+        "free_fall",
+        "--out",
+        out,
+        "--camera",
+        "1,1,1",
+        "--target",
+        "1,1,1"
+    ])
+    .starts_with("camera: "));
+    assert!(refused(&["render", "free_fall", "--out", out, "--fps", "0"]).starts_with("fps: "));
+    assert!(refused(&["render", "free_fall", "--out", out, "--width", "4"]).starts_with("width: "));
+    assert!(
+        refused(&["render", "free_fall", "--out", out, "--duration", "-1"])
+            .starts_with("duration: ")
+    );
+    assert!(
+        refused(&["render", "free_fall", "--out", "/nonexistent/dir/a.gif"])
+            .starts_with("out: cannot write")
+    );
+    let bad = dir.join("bad.json");
+    std::fs::write(
+        &bad,
+        r#"{"bodies": [{"color": "red", "shape": {"type": "sphere", "radius": 1}}]}"#,
+    )
+    .unwrap();
+    assert_eq!(
+        refused(&["render", s(&bad), "--out", out]),
+        "bodies[0].color: expected \"#rrggbb\", got 'red'"
+    );
+}
+
+#[test]
+fn run_stays_quiet_off_a_terminal() {
+    let out = tumble(&["run", "dzhanibekov", "--quiet"]);
+    assert!(out.status.success());
+    assert!(out.stdout.is_empty() && out.stderr.is_empty());
+}
