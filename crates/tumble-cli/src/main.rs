@@ -45,7 +45,7 @@ enum Command {
     /// The run takes ⌈duration / dt⌉ steps of dt; when duration / dt is not a whole
     /// number the last step is shortened so the run ends exactly at `duration`. With
     /// --steps, exactly N steps of dt.
-    Run(run::RunArgs),
+    Run(Box<run::RunArgs>),
     /// Measure every integrator: observed order of convergence and energy behaviour on a
     /// harmonic oscillator, and the largest stable step on a stiff spring; print a table.
     Analyze,
@@ -91,7 +91,7 @@ pub fn stdout_failure(e: io::Error) -> Failure {
 fn main() -> ExitCode {
     // clap prints its own errors and help and exits (2 for errors, 0 for --help).
     let cli = Cli::parse();
-    let command = cli.command.unwrap_or(Command::Run(run::RunArgs::default()));
+    let command = cli.command.unwrap_or_else(|| Command::Run(Box::default()));
     let result = match command {
         Command::Run(args) => run::run(&args),
         Command::Analyze => analyze::analyze(),

@@ -17,8 +17,26 @@ pub const TRAJECTORY_HEADER: &str = "time,body,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,
 /// Header of the contacts file.
 pub const CONTACT_IMPULSES_HEADER: &str =
     "time,body_a,body_b,x,y,z,nx,ny,nz,normal_impulse,tangent_impulse";
+/// Header of the joints file.
+pub const JOINT_REACTIONS_HEADER: &str = "time,joint,body,other,fx,fy,fz,tx,ty,tz,broken";
 /// Header of the diagnostics file.
 pub const DIAGNOSTICS_HEADER: &str = "time,kinetic,potential,total,px,py,pz,lx,ly,lz";
+
+/// The output label of each body id: its name, or its index in the scene's `bodies`.
+fn labeller<'a>(world: &World, labels: &'a [String]) -> impl Fn(tumble::BodyId) -> &'a str {
+    let index: std::collections::BTreeMap<tumble::BodyId, usize> = world
+        .body_ids()
+        .iter()
+        .enumerate()
+        .map(|(i, id)| (*id, i))
+        .collect();
+    move |id| {
+        index
+            .get(&id)
+            .and_then(|i| labels.get(*i))
+            .map_or("", String::as_str)
+    }
+}
 
 /// A number printed with the fewest digits that read back to the same value (Rust's
 /// shortest round-trip formatting), in exponent form when plain digits would run long.
@@ -126,18 +144,7 @@ impl CsvFile {
         world: &World,
         labels: &[String],
     ) -> Result<(), Failure> {
-        let index: std::collections::BTreeMap<tumble::BodyId, usize> = world
-            .body_ids()
-            .iter()
-            .enumerate()
-            .map(|(i, id)| (*id, i))
-            .collect();
-        let label = |id| {
-            index
-                .get(&id)
-                .and_then(|i| labels.get(*i))
-                .map_or("", String::as_str)
-        };
+        let label = labeller(world, labels);
         for c in world.contacts() {
             let n = c.manifold.normal;
             for p in c.manifold.points() {
@@ -159,6 +166,35 @@ impl CsvFile {
                     ),
                 )?;
             }
+        }
+        Ok(())
+    }
+
+    /// A row per joint: its label (name, or index in creation order), its bodies (`world`
+    /// for none), and the force and torque it applied to `other` over the last step
+    /// (N, N·m; the force on `body` is the opposite), and whether it has broken.
+    pub fn joints(&mut self, time: Real, world: &World, labels: &[String]) -> Result<(), Failure> {
+        let body_label = labeller(world, labels);
+        let label = |id: Option<tumble::BodyId>| id.map_or("world", &body_label);
+        for (k, (_, j)) in world.joints().enumerate() {
+            let (f, t) = (j.reaction_force(), j.reaction_torque());
+            let name = j.name().map_or_else(|| k.to_string(), str::to_string);
+            self.row(
+                time,
+                format_args!(
+                    "{},{},{},{},{},{},{},{},{},{}",
+                    csv_text(&name),
+                    csv_text(label(Some(j.body()))),
+                    csv_text(label(j.other())),
+                    Num(f.x),
+                    Num(f.y),
+                    Num(f.z),
+                    Num(t.x),
+                    Num(t.y),
+                    Num(t.z),
+                    u8::from(j.is_broken())
+                ),
+            )?;
         }
         Ok(())
     }

@@ -6,7 +6,9 @@ use clap::Args;
 use tumble::{Real, World};
 use tumble_scene::{RunPlan, Scene, SceneError};
 
-use crate::record::{CsvFile, CONTACT_IMPULSES_HEADER, DIAGNOSTICS_HEADER, TRAJECTORY_HEADER};
+use crate::record::{
+    CsvFile, CONTACT_IMPULSES_HEADER, DIAGNOSTICS_HEADER, JOINT_REACTIONS_HEADER, TRAJECTORY_HEADER,
+};
 use crate::report::{SeedTable, Summary};
 use crate::Failure;
 
@@ -17,7 +19,8 @@ pub const SEED_SCENE: &str = "free_fall";
 #[derive(Args, Debug)]
 pub struct RunArgs {
     /// Scene to run: a built-in name (free_fall, spring, double_spring, dzhanibekov,
-    /// planar_spinner, dumbbell, resting; see `tumble scenes`) or the path of a JSON scene file
+    /// planar_spinner, dumbbell, resting, door, cradle, rope_bridge, ragdoll; see `tumble
+    /// scenes`) or the path of a JSON scene file
     /// (format: docs/scene-format.md). Built-in names win over files in the current
     /// directory. Omitted: the seed's free fall, printed as a table against the analytic
     /// solution.
@@ -61,6 +64,12 @@ pub struct RunArgs {
     #[arg(long, value_name = "FILE")]
     pub contacts: Option<PathBuf>,
 
+    /// Write every joint of every recorded step as CSV to FILE: time (s), joint (its name
+    /// or index), body, other ("world" for none), fx,fy,fz (N) and tx,ty,tz (N·m), the
+    /// force and torque the joint applied to `other` over that step, and broken (0 or 1).
+    #[arg(long, value_name = "FILE")]
+    pub joints: Option<PathBuf>,
+
     /// Contact solver; overrides the scene's `solver`: soft_step (default) or pgs.
     #[arg(long, value_name = "NAME")]
     pub solver: Option<String>,
@@ -95,6 +104,7 @@ impl Default for RunArgs {
             out: None,
             diagnostics: None,
             contacts: None,
+            joints: None,
             solver: None,
             substeps: None,
             iterations: None,
@@ -181,6 +191,7 @@ struct Sinks {
     trajectory: Option<CsvFile>,
     diagnostics: Option<CsvFile>,
     contacts: Option<CsvFile>,
+    joints: Option<CsvFile>,
     seed_table: Option<SeedTable>,
     summary: Option<Summary>,
     labels: Vec<String>,
@@ -189,8 +200,8 @@ struct Sinks {
 
 impl Sinks {
     fn open(args: &RunArgs, scene: &Scene, plan: &RunPlan) -> Result<Sinks, Failure> {
-        let files = [&args.out, &args.diagnostics, &args.contacts];
-        for (i, (name, path)) in ["out", "diagnostics", "contacts"]
+        let files = [&args.out, &args.diagnostics, &args.contacts, &args.joints];
+        for (i, (name, path)) in ["out", "diagnostics", "contacts", "joints"]
             .iter()
             .zip(files)
             .enumerate()
@@ -213,6 +224,7 @@ impl Sinks {
             trajectory: csv("out", &args.out, TRAJECTORY_HEADER)?,
             diagnostics: csv("diagnostics", &args.diagnostics, DIAGNOSTICS_HEADER)?,
             contacts: csv("contacts", &args.contacts, CONTACT_IMPULSES_HEADER)?,
+            joints: csv("joints", &args.joints, JOINT_REACTIONS_HEADER)?,
             seed_table: seed
                 .then(|| SeedTable::new(&scene.world, plan))
                 .transpose()?,
@@ -235,6 +247,9 @@ impl Sinks {
             if let Some(csv) = &mut self.contacts {
                 csv.contacts(time, world, &self.labels)?;
             }
+            if let Some(csv) = &mut self.joints {
+                csv.joints(time, world, &self.labels)?;
+            }
         }
         if let Some(table) = &mut self.seed_table {
             table.observe(k, time, world)?;
@@ -244,9 +259,14 @@ impl Sinks {
 
     fn finish(self, scene: &Scene, plan: &RunPlan) -> Result<(), Failure> {
         let mut written = Vec::new();
-        for csv in [self.trajectory, self.diagnostics, self.contacts]
-            .into_iter()
-            .flatten()
+        for csv in [
+            self.trajectory,
+            self.diagnostics,
+            self.contacts,
+            self.joints,
+        ]
+        .into_iter()
+        .flatten()
         {
             let path = csv.path().display().to_string();
             written.push((path, csv.finish()?));

@@ -481,3 +481,34 @@ fn runs_with_contacts_write_identical_bytes() {
     assert!(first.1.len() > 1000, "hardly any contacts were written");
     assert_eq!(first, second);
 }
+
+#[test]
+fn joint_reactions_are_written_and_carry_the_load() {
+    // The door (0.9 × 2 × 0.04 m of wood at 600 kg/m³: 43.2 kg) hangs on its hinge, which
+    // must carry its weight: the force on the frame is m·g down, and the torque about the
+    // hinge is m·g times the 0.45 m from the hinge to the door's centre.
+    let dir = scratch("joints_csv");
+    let file = dir.join("joints.csv");
+    ok(&["run", "door", "--joints", path(&file), "--quiet"]);
+    let text = std::fs::read_to_string(file).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("time,joint,body,other,fx,fy,fz,tx,ty,tz,broken")
+    );
+    let last: Vec<f64> = lines
+        .last()
+        .unwrap()
+        .split(',')
+        .skip(4)
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let weight = 0.9 * 2.0 * 0.04 * 600.0 * 9.8;
+    assert!((last[1] + weight).abs() < 1e-3 * weight, "fy {}", last[1]);
+    let torque = (last[3] * last[3] + last[4] * last[4] + last[5] * last[5]).sqrt();
+    assert!(
+        (torque - 0.45 * weight).abs() < 1e-2 * weight,
+        "torque {torque}"
+    );
+    assert_eq!(last[6], 0.0, "the hinge broke");
+}

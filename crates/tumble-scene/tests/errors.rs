@@ -38,8 +38,8 @@ fn misspelt_keys_are_refused_with_the_allowed_ones() {
     assert_eq!(
         error(r#"{"gravityy": [0, 0, 0]}"#),
         "gravityy: unknown key (expected one of: name, description, gravity, dt, duration, \
-         integrator, bodies, forces, solver, substeps, iterations, contact_hertz, \
-         contact_damping_ratio, length_unit, sleep)"
+         integrator, bodies, forces, joints, solver, substeps, iterations, contact_hertz, \
+         contact_damping_ratio, joint_hertz, joint_damping_ratio, length_unit, sleep)"
     );
     assert_eq!(
         error(&one_body(r#""velocty": [1, 0, 0]"#)),
@@ -310,7 +310,7 @@ fn files_that_cannot_be_read_are_reported() {
     assert_eq!(
         e.to_string(),
         "scene: 'no_such_scene' is neither a built-in scene (free_fall, spring, double_spring, \
-         dzhanibekov, planar_spinner, dumbbell, resting) nor an existing file"
+         dzhanibekov, planar_spinner, dumbbell, resting, door, cradle, rope_bridge, ragdoll) nor an existing file"
     );
 }
 
@@ -319,8 +319,8 @@ fn user_text_cannot_break_the_line() {
     assert_eq!(
         error(r#"{"du\nration": 1}"#),
         "du\\nration: unknown key (expected one of: name, description, gravity, dt, duration, \
-         integrator, bodies, forces, solver, substeps, iterations, contact_hertz, \
-         contact_damping_ratio, length_unit, sleep)"
+         integrator, bodies, forces, joints, solver, substeps, iterations, contact_hertz, \
+         contact_damping_ratio, joint_hertz, joint_damping_ratio, length_unit, sleep)"
     );
     assert_eq!(error(r#"{"integrator": "rk\n4"}"#).lines().count(), 1);
     assert_eq!(

@@ -518,3 +518,127 @@ fn bad_joint_definitions_name_the_field() {
     assert_eq!(message(&mut w, def.clone()), "length: must be > 0");
     assert_eq!(w.joints().count(), 0);
 }
+
+#[test]
+fn ball_joint_cone_and_twist_limits_hold() {
+    // A rod hangs from the world by a ball joint with its axis along the rod (down). A
+    // sideways push swings it against a 0.5 rad cone; a torque about the rod twists it
+    // against [−0.3, 0.3] rad. Neither limit may be passed by more than 0.01 rad.
+    let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+    let rod = w
+        .create_body(
+            &BodyDef {
+                position: Vec3::new(0.0, -0.5, 0.0),
+                mass: MassSpec::Mass(1.0),
+                ..Default::default()
+            },
+            Shape::cuboid(Vec3::new(0.1, 0.5, 0.1)),
+        )
+        .unwrap();
+    let mut def = JointDef::new(
+        JointKind::Ball {
+            cone: Some(0.5),
+            twist: Some([-0.3, 0.3]),
+        },
+        rod,
+    );
+    def.anchor = Vec3::new(0.0, 0.5, 0.0);
+    def.axis = -Vec3::Y;
+    def.other_axis = -Vec3::Y;
+    w.create_joint(&def).unwrap();
+    w.set_linear_velocity(rod, Vec3::new(4.0, 0.0, 1.0))
+        .unwrap();
+    w.add_force(Force::Applied(AppliedForce {
+        body: rod,
+        force: Vec3::ZERO,
+        point: None,
+        torque: Vec3::new(0.0, 3.0, 0.0),
+    }))
+    .unwrap();
+    let (mut swing, mut twist): (Real, Real) = (0.0, 0.0);
+    for _ in 0..180 {
+        w.step(1.0 / 60.0).unwrap();
+        let q = w.body(rod).unwrap().orientation();
+        let down = q * -Vec3::Y;
+        swing = swing.max(down.angle_between(-Vec3::Y));
+        // Twist as the joint defines it: the angle between the two frames' reference
+        // directions (z, perpendicular to the axis), both laid into the plane across the
+        // axes' mean direction.
+        let mid = (down - Vec3::Y).normalize();
+        let flat = |r: Vec3| (r - mid * mid.dot(r)).normalize();
+        let (r_rod, r_world) = (flat(q * Vec3::Z), flat(Vec3::Z));
+        twist = twist.max(
+            mid.dot(r_world.cross(r_rod))
+                .atan2(r_rod.dot(r_world))
+                .abs(),
+        );
+    }
+    assert!(swing < 0.51, "swung {swing} rad past a 0.5 rad cone");
+    assert!(swing > 0.45, "never reached the cone: {swing}");
+    assert!(twist < 0.31, "twisted {twist} rad past 0.3");
+    assert!(twist > 0.25, "never reached the twist limit: {twist}");
+}
+
+#[test]
+fn slider_limits_springs_and_distance_ropes_behave() {
+    // A slider along x with a spring (2 Hz, undamped) towards 0 and limits [−0.2, 0.2]:
+    // released at 0.1 m with no gravity, it oscillates at 2 Hz within the limits.
+    let mut w = world_with(Vec3::ZERO);
+    let body = unit_box(&mut w, Vec3::new(0.1, 0.0, 0.0), 1.0);
+    let mut def = JointDef::new(
+        JointKind::Slider {
+            limits: Some([-0.2, 0.2]),
+            motor: None,
+            spring: Some(JointSpring {
+                hertz: 2.0,
+                damping_ratio: 0.0,
+                target: 0.0,
+            }),
+        },
+        body,
+    );
+    def.anchor = Vec3::ZERO;
+    def.other_anchor = Vec3::ZERO;
+    w.create_joint(&def).unwrap();
+    let dt = 1.0 / 240.0;
+    let mut crossings = Vec::new();
+    let mut last = 0.1;
+    for i in 0..(2.0 / dt) as usize {
+        w.step(dt).unwrap();
+        let x = w.body(body).unwrap().center_of_mass().x;
+        if last > 0.0 && x <= 0.0 {
+            crossings.push(i as Real * dt);
+        }
+        last = x;
+    }
+    let period = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as Real;
+    assert!(
+        (period - 0.5).abs() < 0.01,
+        "spring period {period} s, expected 0.5"
+    );
+
+    // A 1 kg ball on a 1 m rope (max only) dropped from 0.5 m beside the anchor: it
+    // falls freely until the rope tightens, then hangs at 1 m.
+    let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+    let b = ball(&mut w, Vec3::new(0.5, 0.0, 0.0));
+    let mut def = JointDef::new(
+        JointKind::Distance {
+            length: Some(1.0),
+            min: None,
+            max: Some(1.0),
+            spring: None,
+        },
+        b,
+    );
+    def.other_anchor = Vec3::ZERO;
+    w.create_joint(&def).unwrap();
+    w.step(1.0 / 60.0).unwrap();
+    let v = w.body(b).unwrap().linear_velocity();
+    assert!((v.y + G / 60.0).abs() < 1e-6, "a slack rope pulled: {v}");
+    let mut longest: Real = 0.0;
+    for _ in 0..600 {
+        w.step(1.0 / 60.0).unwrap();
+        longest = longest.max(w.body(b).unwrap().center_of_mass().length());
+    }
+    assert!(longest < 1.01, "the rope stretched to {longest} m");
+}

@@ -227,9 +227,16 @@ impl JointConstraint {
         let hard = self.hard_rows(&fr);
         let free = self.free_rows(&fr);
         let cone = self.cone_row(&fr);
+        let point = self.point_apart().then(|| point_impulse(&imp));
         self.with_states(states, |a, b| {
-            for i in 0..hard.count {
-                hard.rows[i].apply(imp.hard[i], &fr.sa, &fr.sb, a, b);
+            if let Some(p) = point {
+                apply_point(p, &fr, a, b);
+            }
+            for (row, lambda) in hard
+                .iter()
+                .flat_map(|h| h.rows[..h.count].iter().zip(imp.hard))
+            {
+                row.apply(lambda, &fr.sa, &fr.sb, a, b);
             }
             if let Some((row, _)) = free {
                 row.apply(free_impulse(&imp), &fr.sa, &fr.sb, a, b);
@@ -249,6 +256,7 @@ impl JointConstraint {
         let free = self.free_rows(&fr);
         let cone = self.cone_row(&fr);
         let hard = self.hard_rows(&fr);
+        let point = self.point_apart();
         self.with_states(states, |a, b| {
             if let Some((row, coordinate)) = free {
                 solve_free(&kind, row, coordinate, rest, &fr, pass, &mut imp, a, b);
@@ -256,8 +264,12 @@ impl JointConstraint {
             if let Some((row, c)) = cone {
                 imp.cone = solve_limit(row, c, imp.cone, &fr, pass, a, b);
             }
-            if hard.count > 0 {
-                imp.hard = solve_hard(&hard, imp.hard, &fr, pass, a, b);
+            if let Some(hard) = &hard {
+                imp.hard = solve_hard(hard, imp.hard, &fr, pass, a, b);
+            }
+            if point {
+                let p = solve_point(point_impulse(&imp), &fr, pass, a, b);
+                imp.hard[..3].copy_from_slice(&p.to_array());
             }
         });
         self.impulses = imp;
@@ -269,20 +281,21 @@ impl JointConstraint {
         let fr = self.frame(sims);
         let imp = self.impulses;
         let hard = self.hard_rows(&fr);
-        let mut rows: Vec<(Row, Real)> = (0..hard.count)
-            .map(|i| (hard.rows[i], imp.hard[i]))
-            .collect();
-        if let Some((row, _)) = self.free_rows(&fr) {
-            rows.push((row, free_impulse(&imp)));
-        }
-        if let Some((row, _)) = self.cone_row(&fr) {
-            rows.push((row, imp.cone));
-        }
-        for (row, lambda) in rows {
+        let free = self
+            .free_rows(&fr)
+            .map(|(row, _)| (row, free_impulse(&imp)));
+        let cone = self.cone_row(&fr).map(|(row, _)| (row, imp.cone));
+        let rows = hard
+            .iter()
+            .flat_map(|h| h.rows[..h.count].iter().copied().zip(imp.hard));
+        for (row, lambda) in rows.chain(free).chain(cone) {
             self.total_linear += row.lin * lambda;
             if row.lin == Vec3::ZERO {
                 self.total_angular += row.ang_b * lambda;
             }
+        }
+        if self.point_apart() {
+            self.total_linear += point_impulse(&imp);
         }
     }
 
@@ -299,18 +312,25 @@ impl JointConstraint {
         }
     }
 
-    /// The joint's equality rows (see the module's table).
-    fn hard_rows(&self, fr: &Frame) -> HardRows {
+    /// Whether the point constraint is solved on its own, as a 3×3 block with glam: a
+    /// ball joint has no other equality rows to couple it to (the joint grid benchmark
+    /// spent a third of its time in the general elimination).
+    fn point_apart(&self) -> bool {
+        matches!(self.kind, JointKind::Ball { .. })
+    }
+
+    /// The joint's equality rows (see the module's table); a ball joint's point is solved
+    /// apart (see `point_apart`).
+    fn hard_rows(&self, fr: &Frame) -> Option<HardRows> {
+        if self.point_apart() {
+            return None;
+        }
         let mut hard = HardRows {
             rows: [Row::angular(Vec3::ZERO); 6],
             error: [0.0; 6],
             count: 0,
         };
-        let point = matches!(
-            self.kind,
-            JointKind::Ball { .. } | JointKind::Hinge { .. } | JointKind::Fixed
-        );
-        if point {
+        if matches!(self.kind, JointKind::Hinge { .. } | JointKind::Fixed) {
             for e in [Vec3::X, Vec3::Y, Vec3::Z] {
                 let row = Row {
                     lin: e,
@@ -354,7 +374,7 @@ impl JointConstraint {
                 hard.push(Row::angular(axis), axis.dot(error));
             }
         }
-        hard
+        Some(hard)
     }
 
     /// The slider's (or hinge's) axis in the world, carried by body a.
@@ -425,6 +445,93 @@ impl JointConstraint {
         // The margin shrinks as b swings away about n: Ċ = −n·(ω_b − ω_a).
         Some((Row::angular(n).negated(), cone - angle))
     }
+}
+
+/// The point constraint's accumulated impulse (on `other`, world frame).
+fn point_impulse(imp: &JointImpulses) -> Vec3 {
+    Vec3::new(imp.hard[0], imp.hard[1], imp.hard[2])
+}
+
+/// Applies a linear impulse `p` at the anchors: −p on `body`, +p on `other`.
+fn apply_point(p: Vec3, fr: &Frame, a: &mut BodyState, b: &mut BodyState) {
+    if fr.sa.moves {
+        a.v -= fr.sa.mask * p * fr.sa.inv_mass;
+        a.w -= fr.sa.inv_inertia * fr.ra.cross(p);
+    }
+    if fr.sb.moves {
+        b.v += fr.sb.mask * p * fr.sb.inv_mass;
+        b.w += fr.sb.inv_inertia * fr.rb.cross(p);
+    }
+}
+
+/// [r]× M [r]×: the turning part of a point's inverse effective mass is minus this.
+/// Column i is r × (M (r × eᵢ)), and r × eᵢ has two terms: half the work of two full
+/// matrix products.
+fn skew_sandwich(r: Vec3, m: Mat3) -> Mat3 {
+    let column = |turned: Vec3| r.cross(turned);
+    Mat3::from_cols(
+        column(m.y_axis * r.z - m.z_axis * r.y),
+        column(m.z_axis * r.x - m.x_axis * r.z),
+        column(m.x_axis * r.y - m.y_axis * r.x),
+    )
+}
+
+/// The point constraint as one 3×3 block:
+/// K = (m_a⁻¹ + m_b⁻¹) 1 − [r_a]× I_a⁻¹ [r_a]× − [r_b]× I_b⁻¹ [r_b]×.
+fn solve_point(
+    acc: Vec3,
+    fr: &Frame,
+    pass: &JointPass,
+    a: &mut BodyState,
+    b: &mut BodyState,
+) -> Vec3 {
+    let k = Mat3::from_diagonal(fr.sa.mask * fr.sa.inv_mass + fr.sb.mask * fr.sb.inv_mass)
+        - skew_sandwich(fr.ra, fr.sa.inv_inertia)
+        - skew_sandwich(fr.rb, fr.sb.inv_inertia);
+    let cdot = b.v + b.w.cross(fr.rb) - a.v - a.w.cross(fr.ra);
+    let bias = if pass.bias {
+        fr.d * pass.soft.bias_rate
+    } else {
+        Vec3::ZERO
+    };
+    let det = k.determinant();
+    let x = if det.abs()
+        > 1e-12
+            * k.x_axis
+                .x
+                .abs()
+                .max(k.y_axis.y.abs())
+                .max(k.z_axis.z.abs())
+                .powi(3)
+    {
+        k.inverse() * -(cdot + bias)
+    } else {
+        // A direction no body can move in (a planar body out of its plane): the general
+        // elimination leaves it alone.
+        let hard = HardRows {
+            rows: [
+                Vec3::X,
+                Vec3::Y,
+                Vec3::Z,
+                Vec3::ZERO,
+                Vec3::ZERO,
+                Vec3::ZERO,
+            ]
+            .map(|e| Row {
+                lin: e,
+                ang_a: fr.ra.cross(e),
+                ang_b: fr.rb.cross(e),
+            }),
+            error: [fr.d.x, fr.d.y, fr.d.z, 0.0, 0.0, 0.0],
+            count: 3,
+        };
+        let acc6 = [acc.x, acc.y, acc.z, 0.0, 0.0, 0.0];
+        let total = solve_hard(&hard, acc6, fr, pass, a, b);
+        return Vec3::new(total[0], total[1], total[2]);
+    };
+    let impulse = x * pass.soft.mass_scale - acc * pass.soft.impulse_scale;
+    apply_point(impulse, fr, a, b);
+    acc + impulse
 }
 
 /// The hard rows of a joint: Jacobians and position errors.

@@ -399,18 +399,12 @@ impl Solver {
 /// (there is no relax pass) for PGS.
 fn joint_passes(settings: &SolverSettings, h: Real) -> (JointPass, JointPass) {
     let inv_h = 1.0 / h;
-    let soft = match settings.kind {
-        SolverKind::SoftStep => Softness::new(
-            settings.joint_hertz.min(0.25 * inv_h),
-            settings.joint_damping_ratio,
-            h,
-        ),
-        SolverKind::Pgs => Softness {
-            bias_rate: settings.baumgarte * inv_h,
-            mass_scale: 1.0,
-            impulse_scale: 0.0,
-        },
-    };
+    let soft = biased_softness(
+        settings,
+        settings.joint_hertz,
+        settings.joint_damping_ratio,
+        h,
+    );
     let pass = |soft, bias| JointPass {
         soft,
         bias,
@@ -420,24 +414,32 @@ fn joint_passes(settings: &SolverSettings, h: Real) -> (JointPass, JointPass) {
     (pass(soft, true), pass(Softness::RIGID, false))
 }
 
-/// The soft spring for the soft step (capped at a quarter of the substep rate, as in
-/// Box2D); the rigid row with Baumgarte's β/h for PGS.
+/// Position correction in a biased pass: for the soft step a spring of `hertz` (capped at
+/// a quarter of the substep rate, as in Box2D) and damping ratio `zeta`; for PGS the rigid
+/// row with Baumgarte's β/h.
+fn biased_softness(settings: &SolverSettings, hertz: Real, zeta: Real, h: Real) -> Softness {
+    let inv_h = 1.0 / h;
+    match settings.kind {
+        SolverKind::SoftStep => Softness::new(hertz.min(0.25 * inv_h), zeta, h),
+        SolverKind::Pgs => Softness {
+            bias_rate: settings.baumgarte * inv_h,
+            mass_scale: 1.0,
+            impulse_scale: 0.0,
+        },
+    }
+}
+
+/// Contacts' position correction and the lengths and speeds they work with.
 fn bias_rule(settings: &SolverSettings, scales: &Scales, h: Real) -> BiasRule {
     let inv_h = 1.0 / h;
     BiasRule {
         inv_h,
-        softness: match settings.kind {
-            SolverKind::SoftStep => Softness::new(
-                settings.contact_hertz.min(0.25 * inv_h),
-                settings.contact_damping_ratio,
-                h,
-            ),
-            SolverKind::Pgs => Softness {
-                bias_rate: settings.baumgarte * inv_h,
-                mass_scale: 1.0,
-                impulse_scale: 0.0,
-            },
-        },
+        softness: biased_softness(
+            settings,
+            settings.contact_hertz,
+            settings.contact_damping_ratio,
+            h,
+        ),
         slop: if settings.kind == SolverKind::Pgs {
             scales.linear_slop
         } else {

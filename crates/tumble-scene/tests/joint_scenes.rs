@@ -1,0 +1,170 @@
+//! The joint scenes and the `joints` key: what each built-in joint scene must show, and how
+//! joints read from a scene file.
+
+// Casts between Real and f64 are no-ops in the default build but needed in the f32 one.
+#![allow(clippy::unnecessary_cast)]
+
+use tumble::prelude::*;
+use tumble_scene::{load, load_str};
+
+/// Steps a loaded scene for its whole duration, returning the largest joint gap seen.
+fn run_scene(name: &str) -> (tumble_scene::Scene, Real) {
+    let mut scene = load(name).unwrap();
+    let steps = (scene.duration / scene.dt).round() as usize;
+    let mut worst: Real = 0.0;
+    for _ in 0..steps {
+        scene.world.step(scene.dt).unwrap();
+        worst = worst.max(joint_gap(&scene.world));
+    }
+    (scene, worst)
+}
+
+/// The largest distance between the two anchors of any unbroken joint that holds them
+/// together (distance joints keep them apart, see `rope_lengths`).
+fn joint_gap(w: &World) -> Real {
+    w.joints()
+        .filter(|(_, j)| !j.is_broken() && !matches!(j.kind(), JointKind::Distance { .. }))
+        .map(|(_, j)| anchor_distance(w, j))
+        .fold(0.0, Real::max)
+}
+
+/// How far apart a joint's two anchors are now.
+fn anchor_distance(w: &World, j: &tumble::Joint) -> Real {
+    let d = j.def();
+    let a = w.body(d.body).unwrap().pose().transform_point(d.anchor);
+    let b = match d.other {
+        Some(o) => w.body(o).unwrap().pose().transform_point(d.other_anchor),
+        None => d.other_anchor,
+    };
+    (a - b).length()
+}
+
+fn body<'a>(w: &'a World, name: &str) -> &'a Body {
+    w.body(w.find_body(name).unwrap()).unwrap()
+}
+
+#[test]
+fn the_door_opens_under_its_motor_until_its_limit() {
+    // 1 rad/s for 3 s would turn it 3 rad; the limit stops it at π/2 (within 0.01 rad).
+    let (scene, gap) = run_scene("door");
+    let door = body(&scene.world, "door");
+    let (axis, angle) = door.orientation().to_axis_angle();
+    assert!(axis.y > 0.99, "turned about {axis}");
+    let quarter = std::f64::consts::FRAC_PI_2 as Real;
+    assert!((angle - quarter).abs() < 0.01, "door at {angle} rad");
+    assert!(gap < 1e-3, "hinge gap {gap}");
+}
+
+#[test]
+fn the_cradle_passes_the_swing_to_the_last_ball() {
+    // Ball 0 falls through 0.6 rad and strikes the row. A quarter period of the 0.8 m
+    // strings later, ball 4 has swung out while ball 0 hangs nearly still: ball 4 must
+    // reach 80 % of ball 0's release height, and ball 0 must rise less than a tenth of it.
+    let mut scene = load("cradle").unwrap();
+    let w = &mut scene.world;
+    let rest = body(w, "ball4").center_of_mass().y;
+    let lift = body(w, "ball0").center_of_mass().y - rest;
+    let dt = scene.dt;
+    let (mut high4, mut high0): (Real, Real) = (0.0, 0.0);
+    // First strike after a quarter period (~0.45 s); the last ball's apex a quarter later.
+    for i in 0..(1.0 / dt) as usize {
+        w.step(dt).unwrap();
+        if i as Real * dt > 0.5 {
+            high4 = high4.max(body(w, "ball4").center_of_mass().y - rest);
+            high0 = high0.max(body(w, "ball0").center_of_mass().y - rest);
+        }
+    }
+    assert!(high4 > 0.8 * lift, "last ball rose {high4} of {lift}");
+    assert!(high0 < 0.1 * lift, "first ball rose {high0} of {lift}");
+    // The strings (rods: no min or max) keep their length to a millimetre.
+    for length in rope_lengths(w) {
+        assert!(
+            (length - 0.8544).abs() < 1e-3,
+            "a string is {length} m long"
+        );
+    }
+}
+
+/// Distance between the anchors of every distance joint.
+fn rope_lengths(w: &World) -> Vec<Real> {
+    w.joints()
+        .filter(|(_, j)| matches!(j.kind(), JointKind::Distance { .. }))
+        .map(|(_, j)| anchor_distance(w, j))
+        .collect()
+}
+
+#[test]
+fn the_rope_bridge_holds_its_crates_above_the_ground() {
+    // The bridge is longer than its span (1 cm of slack per rope), so it sags and, with
+    // nothing but its joints to damp it, still sways at the end; the crates ride on it.
+    let (scene, _) = run_scene("rope_bridge");
+    let w = &scene.world;
+    for k in 0..3 {
+        let c = body(w, &format!("crate{k}")).position();
+        assert!(c.y > 1.0 && c.x.abs() < 4.0, "crate{k} fell off, to {c}");
+    }
+    // Ropes hold their 6 cm maximum to within a centimetre under the crates' weight.
+    for length in rope_lengths(w) {
+        assert!(length < 0.06 + 0.01, "a rope stretched to {length} m");
+    }
+}
+
+#[test]
+fn the_ragdoll_falls_down_the_stairs_in_one_piece() {
+    let (scene, gap) = run_scene("ragdoll");
+    let w = &scene.world;
+    for (_, b) in w.bodies() {
+        assert!(b.position().is_finite() && b.linear_velocity().is_finite());
+    }
+    let pelvis = body(w, "pelvis").position();
+    assert!(
+        pelvis.x > 1.0,
+        "the ragdoll stayed on the top step: {pelvis}"
+    );
+    // Limbs whipped by impacts stretch their joints for a moment; at the end, at rest:
+    assert!(
+        joint_gap(w) < 0.01,
+        "a joint is {} m apart at rest",
+        joint_gap(w)
+    );
+    assert!(gap < 0.1, "a joint opened {gap} m during the fall");
+}
+
+#[test]
+fn joints_read_from_a_scene_with_defaults_and_named_errors() {
+    let scene = r#"{
+        "bodies": [
+            {"name": "a", "shape": {"type": "sphere", "radius": 0.1}, "position": [0, 1, 0]},
+            {"name": "b", "shape": {"type": "sphere", "radius": 0.1}, "position": [1, 1, 0]}
+        ],
+        "joints": [
+            {"type": "hinge", "name": "h", "body": "a", "anchor": [0.5, 0, 0], "other": "b",
+             "axis": [0, 0, 1], "limits": [-1, 1], "motor": {"speed": 1, "max_torque": 2},
+             "break_force": 100},
+            {"type": "distance", "body": "b", "other": null, "other_anchor": [1, 2, 0],
+             "max": 1.5}
+        ]
+    }"#;
+    let s = load_str(scene).unwrap();
+    let w = &s.world;
+    let h = w.joint(w.find_joint("h").unwrap()).unwrap();
+    // other_anchor and other_axis left out: the body's, seen from the other body.
+    assert!((h.def().other_anchor - Vec3::new(-0.5, 0.0, 0.0)).length() < 1e-9);
+    assert!((h.def().other_axis - Vec3::Z).length() < 1e-9);
+    assert!(matches!(h.kind(), JointKind::Hinge { motor: Some(m), .. } if m.max_force == 2.0));
+    assert_eq!(w.joints().count(), 2);
+    for (bad, message) in [
+        (r#"{"type": "hinge", "body": "a", "limits": [1, -1]}"#, "joints[0].limits: lower must be <= upper"),
+        (r#"{"type": "hinge", "body": "zz"}"#, "joints[0].body: no body named 'zz'"),
+        (r#"{"type": "rope", "body": "a"}"#, "joints[0].type: unknown joint type 'rope' (expected one of: ball, hinge, slider, fixed, distance)"),
+        (r#"{"type": "slider", "body": "a", "motor": {"speed": 1, "max_force": -1}}"#, "joints[0].motor.max_force: must be >= 0"),
+        (r#"{"type": "ball", "body": "a", "limits": [0, 1]}"#, "joints[0].limits: unknown key"),
+    ] {
+        let json = format!(
+            r#"{{"bodies": [{{"name": "a", "shape": {{"type": "sphere", "radius": 0.1}}}}],
+                 "joints": [{bad}]}}"#
+        );
+        let err = load_str(&json).expect_err("accepted a bad joint").to_string();
+        assert!(err.starts_with(message), "{err}\n  expected {message}");
+    }
+}
