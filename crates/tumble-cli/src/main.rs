@@ -6,6 +6,7 @@
 
 mod analyze;
 mod contacts;
+mod plot;
 mod progress;
 mod record;
 mod render;
@@ -48,7 +49,7 @@ enum Command {
     Run(Box<run::RunArgs>),
     /// Measure every integrator: observed order of convergence and energy behaviour on a
     /// harmonic oscillator, and the largest stable step on a stiff spring; print a table.
-    Analyze,
+    Analyze(analyze::AnalyzeArgs),
     /// List the built-in scenes with their descriptions.
     Scenes,
     /// Print the contact points of a scene's initial state as CSV:
@@ -60,6 +61,10 @@ enum Command {
     /// shaded in its own colour (or the scene's `color`), planes as a ground grid, the
     /// time in the top-left corner.
     Render(render::RenderArgs),
+    /// Plot the columns of a CSV file against its first column as PNG, e.g. the energies
+    /// and momenta of `tumble run --diagnostics diag.csv`: energies in one panel, the other
+    /// columns in a second.
+    Plot(plot::PlotArgs),
 }
 
 /// Why the program stops early.
@@ -94,7 +99,8 @@ fn main() -> ExitCode {
     let command = cli.command.unwrap_or_else(|| Command::Run(Box::default()));
     let result = match command {
         Command::Run(args) => run::run(&args),
-        Command::Analyze => analyze::analyze(),
+        Command::Analyze(args) => analyze::analyze(&args),
+        Command::Plot(args) => plot::plot(&args),
         Command::Scenes => report::list_scenes(),
         Command::Contacts(args) => contacts::contacts(&args),
         Command::Render(args) => render::render(&args),

@@ -177,7 +177,7 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
             printable(&args.out.display().to_string())
         ))
     };
-    let mut encoder = Encoder::create(&c.output, args.width, args.height, args.fps as f32)
+    let mut encoder = Encoder::create(&c.output, args.width, args.height, narrow(args.fps))
         .map_err(out_failure)?;
     let mut progress = Progress::new(snapshots.len() as u64, "drawing", args.quiet);
     for s in &snapshots {
@@ -223,4 +223,9 @@ fn camera(
     let camera = Camera::look_at(eye, target, args.width, args.height).unwrap_or(auto);
     let scale = (max - min).length().max(0.5);
     (camera, scale)
+}
+
+#[allow(clippy::unnecessary_cast)] // a no-op in the f32 build
+fn narrow(x: Real) -> f32 {
+    x as f32
 }

@@ -208,3 +208,95 @@ fn run_stays_quiet_off_a_terminal() {
     assert!(out.status.success());
     assert!(out.stdout.is_empty() && out.stderr.is_empty());
 }
+
+/// (count, mean row, mean column) of the pixels of exactly this colour.
+fn pixels_of(
+    rgba: &[u8],
+    width: u32,
+    colour: (u8, u8, u8),
+    columns: std::ops::Range<u32>,
+) -> (usize, f64) {
+    let (mut n, mut rows) = (0, 0.0);
+    for (i, p) in rgba.chunks(4).enumerate() {
+        let x = i as u32 % width;
+        if columns.contains(&x) && (p[0], p[1], p[2]) == colour {
+            n += 1;
+            rows += (i as u32 / width) as f64;
+        }
+    }
+    (n, rows / n.max(1) as f64)
+}
+
+#[test]
+fn plot_draws_each_column_as_its_own_line() {
+    let dir = scratch("plot");
+    let csv = dir.join("diag.csv");
+    let mut text = String::from("time,kinetic,total\n");
+    for k in 0..=50 {
+        let t = k as f64 * 0.1;
+        text.push_str(&format!("{t},{},{}\n", 2.0 * t, 10.0 - 0.5 * t));
+    }
+    std::fs::write(&csv, text).unwrap();
+    let png = dir.join("energy.png");
+    let said = ok(&[
+        "plot",
+        s(&csv),
+        "--out",
+        s(&png),
+        "--width",
+        "400",
+        "--height",
+        "300",
+    ]);
+    assert!(said.contains("2 columns against time"), "{said}");
+    let (w, h, rgba) = read_png(&png).unwrap();
+    assert_eq!((w, h), (400, 300));
+    let [kinetic, total] = [0, 1].map(|i| tumble_render::plot::SERIES_COLOURS[i]);
+    // Kinetic energy rises: its pixels sit lower (larger rows) on the left than on the
+    // right. Total energy falls slowly: the other way round.
+    let (nl, left) = pixels_of(&rgba, w, kinetic, 100..200);
+    let (nr, right) = pixels_of(&rgba, w, kinetic, 200..380);
+    assert!(
+        nl > 20 && nr > 20 && left > right + 20.0,
+        "kinetic: {left} vs {right}"
+    );
+    let (nl, left) = pixels_of(&rgba, w, total, 100..200);
+    let (nr, right) = pixels_of(&rgba, w, total, 200..380);
+    assert!(
+        nl > 20 && nr > 20 && left < right,
+        "total: {left} vs {right}"
+    );
+
+    assert!(refused(&[
+        "plot",
+        s(&csv),
+        "--out",
+        s(&png),
+        "--columns",
+        "kinetic,nope"
+    ])
+    .starts_with("columns: no column 'nope'"));
+    assert!(refused(&["plot", s(&csv), "--out", "x.jpg"]).starts_with("out: "));
+    std::fs::write(&csv, "time,body\n0,ball\n").unwrap();
+    assert_eq!(
+        refused(&["plot", s(&csv), "--out", s(&png)]),
+        "file: row 2, column 'body': 'ball' is not a number"
+    );
+}
+
+#[test]
+fn analyze_plot_draws_the_seven_integrators() {
+    let dir = scratch("analyze");
+    let png = dir.join("convergence.png");
+    let said = ok(&["analyze", "--plot", s(&png)]);
+    assert!(said.contains("wrote '"), "{said}");
+    let (w, _, rgba) = read_png(&png).unwrap();
+    for (i, colour) in tumble_render::plot::SERIES_COLOURS[..7].iter().enumerate() {
+        let (n, _) = pixels_of(&rgba, w, *colour, 0..w);
+        assert!(n > 200, "integrator {i}: {n} pixels of its colour");
+    }
+    assert_eq!(
+        refused(&["analyze", "--plot", "c.svg"]),
+        "plot: must be a .png file"
+    );
+}

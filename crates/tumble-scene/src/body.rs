@@ -7,7 +7,6 @@ use crate::reader::{Node, Obj};
 
 const BODY_KEYS: [&str; 18] = [
     "name",
-    "color",
     "kind",
     "shape",
     "mass",
@@ -24,6 +23,7 @@ const BODY_KEYS: [&str; 18] = [
     "friction",
     "restitution",
     "bullet",
+    "color",
 ];
 
 /// A body's `color`, `"#rrggbb"`: for pictures and the viewer only, never for physics.

@@ -45,7 +45,7 @@ fn misspelt_keys_are_refused_with_the_allowed_ones() {
         error(&one_body(r#""velocty": [1, 0, 0]"#)),
         "bodies[0].velocty: unknown key (expected one of: name, kind, shape, mass, density, \
          inertia, center_of_mass, position, orientation, velocity, angular_velocity, planar, \
-         collision_group, collision_mask, friction, restitution, bullet)"
+         collision_group, collision_mask, friction, restitution, bullet, color)"
     );
     assert_eq!(
         error(&with_forces(
@@ -296,6 +296,20 @@ fn missing_required_keys_are_named() {
         error(&with_forces(r#"[{"type": "drag"}]"#)),
         "forces[0].body: missing required key"
     );
+}
+
+#[test]
+fn colours_must_be_hex_triplets() {
+    for bad in [r#""red""#, r##""#ff00""##, r##""#gg0000""##, "[1, 0, 0]"] {
+        let e = error(&one_body(&format!(r#""color": {bad}"#)));
+        assert!(e.starts_with("bodies[0].color: expected "), "{bad}: {e}");
+    }
+    let scene = tumble_scene::load_str(
+        r##"{"bodies": [{"color": "#FF8000", "shape": {"type": "sphere", "radius": 1}},
+                         {"shape": {"type": "sphere", "radius": 1}}]}"##,
+    )
+    .unwrap();
+    assert_eq!(scene.body_colors, [Some([255, 128, 0]), None]);
 }
 
 #[test]
