@@ -20,3 +20,6 @@ cargo test --workspace --exclude tumble-bench --locked --features tumble/f32
 
 step "tests (default f64 build)"
 cargo test --workspace --exclude tumble-bench --locked
+
+step "web viewer in headless Chromium (scripts/browser-test.sh; screenshots in target/browser-test/)"
+bash scripts/browser-test.sh

@@ -13,6 +13,7 @@ mod render;
 mod report;
 mod run;
 mod sample;
+mod web;
 
 use std::io::{self, Write};
 use std::process::ExitCode;
@@ -65,6 +66,12 @@ enum Command {
     /// and momenta of `tumble run --diagnostics diag.csv`: energies in one panel, the other
     /// columns in a second.
     Plot(plot::PlotArgs),
+    /// Write one self-contained HTML file that plays the run in a browser (no network
+    /// needed): orbit camera, play, pause, speed, a time scrubber, click a body for its
+    /// position, velocity, ω and L, and live plots of the energies and |L|.
+    ExportHtml(web::ExportArgs),
+    /// Serve the page of `export-html` on localhost and open it in the browser.
+    View(web::ViewArgs),
 }
 
 /// Why the program stops early.
@@ -101,6 +108,8 @@ fn main() -> ExitCode {
         Command::Run(args) => run::run(&args),
         Command::Analyze(args) => analyze::analyze(&args),
         Command::Plot(args) => plot::plot(&args),
+        Command::ExportHtml(args) => web::export(&args),
+        Command::View(args) => web::view(&args),
         Command::Scenes => report::list_scenes(),
         Command::Contacts(args) => contacts::contacts(&args),
         Command::Render(args) => render::render(&args),

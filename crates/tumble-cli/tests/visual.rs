@@ -300,3 +300,119 @@ fn analyze_plot_draws_the_seven_integrators() {
         "plot: must be a .png file"
     );
 }
+
+/// The JSON recorded into a page.
+fn page_data(html: &str) -> serde_json::Value {
+    let start = html.find(r#"type="application/json">"#).unwrap() + 24;
+    let end = start + html[start..].find("</script>").unwrap();
+    serde_json::from_str(&html[start..end]).unwrap()
+}
+
+#[test]
+fn export_html_writes_one_offline_page_with_the_run() {
+    let dir = scratch("html");
+    let scene = dir.join("falling.json");
+    std::fs::write(&scene, FALLING.replace("\"ball\"", "\"</script><b>ball\"")).unwrap();
+    let html_path = dir.join("sim.html");
+    let said = ok(&[
+        "export-html",
+        s(&scene),
+        "--out",
+        s(&html_path),
+        "--fps",
+        "10",
+    ]);
+    assert!(said.contains("opens offline"), "{said}");
+    let html = std::fs::read_to_string(&html_path).unwrap();
+    // Self-contained: no script, style or module is fetched from anywhere.
+    for needle in ["<script src", "<link", "import(\"http", "from\"http"] {
+        assert!(!html.contains(needle), "page refers to {needle}");
+    }
+    assert_eq!(
+        html.matches("</script>").count(),
+        2,
+        "a body name closed a script early"
+    );
+    let data = page_data(&html);
+    let times = data["times"].as_array().unwrap();
+    assert_eq!(times.len(), 6);
+    assert_eq!(data["bodies"][1]["color"], "#ff0000");
+    assert_eq!(data["bodies"][1]["name"], "</script><b>ball");
+    assert!(data["bodies"][0]["plane"].is_object());
+    assert!(data["bodies"][1]["mesh"].as_array().unwrap().len() > 300);
+    // The ball falls ½ g t²: y at frame k is 2 - 4.9 (k/10)².
+    let positions = data["frames"]["position"].as_array().unwrap();
+    for (k, p) in positions.iter().enumerate() {
+        let y = p[4].as_f64().unwrap();
+        let t = k as f64 / 10.0;
+        assert!((y - (2.0 - 4.9 * t * t)).abs() < 0.03, "frame {k}: y = {y}");
+    }
+    // Energy is conserved in free fall (symplectic Euler: to within one step's worth).
+    let total: Vec<f64> = data["energy"]["total"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert!(
+        total
+            .iter()
+            .all(|e| (e - total[0]).abs() < 0.02 * total[0].abs()),
+        "{total:?}"
+    );
+    assert!(refused(&[
+        "export-html",
+        "free_fall",
+        "--out",
+        s(&html_path),
+        "--fps",
+        "-1"
+    ])
+    .starts_with("fps: "));
+    assert!(
+        refused(&["export-html", "free_fall", "--out", "/nonexistent/x.html"])
+            .starts_with("out: cannot write")
+    );
+}
+
+#[test]
+fn view_serves_the_page_on_localhost() {
+    use std::io::{BufRead, BufReader, Read, Write};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tumble"))
+        .args([
+            "view",
+            "free_fall",
+            "--duration",
+            "0.2",
+            "--no-open",
+            "--requests",
+            "2",
+            "-q",
+        ])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stdout.as_mut().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let url = line.split_whitespace().nth(1).unwrap().to_string();
+    let host = url
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .to_string();
+    assert!(host.starts_with("127.0.0.1:"), "{line}");
+    let get = |path: &str| {
+        let mut stream = std::net::TcpStream::connect(&host).unwrap();
+        let request = format!("GET {path} HTTP/1.1\r\nHost: {host}\r\n\r\n");
+        stream.write_all(request.as_bytes()).unwrap();
+        let mut reply = String::new();
+        stream.read_to_string(&mut reply).unwrap();
+        reply
+    };
+    let page = get("/");
+    assert!(page.starts_with("HTTP/1.1 200 OK"), "{}", &page[..60]);
+    assert_eq!(page_data(&page)["times"].as_array().unwrap().len(), 7);
+    assert!(get("/favicon.ico").starts_with("HTTP/1.1 404"));
+    assert!(child.wait().unwrap().success());
+}
