@@ -19,9 +19,9 @@ pub const SEED_SCENE: &str = "free_fall";
 #[derive(Args, Debug)]
 pub struct RunArgs {
     /// Scene to run: a built-in name (free_fall, spring, double_spring, dzhanibekov,
-    /// planar_spinner, dumbbell, resting, door, cradle, rope_bridge, ragdoll; see `tumble
-    /// scenes`) or the path of a JSON scene file
-    /// (format: docs/scene-format.md). Built-in names win over files in the current
+    /// planar_spinner, dumbbell, resting, door, cradle, rope_bridge, ragdoll, pyramid,
+    /// pendulum_chain; see `tumble scenes`) or the path of a JSON scene file (format:
+    /// docs/scene-format.md). Built-in names win over files in the current
     /// directory. Omitted: the seed's free fall, printed as a table against the analytic
     /// solution.
     #[arg(value_name = "SCENE")]

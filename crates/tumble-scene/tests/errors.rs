@@ -324,7 +324,7 @@ fn files_that_cannot_be_read_are_reported() {
     assert_eq!(
         e.to_string(),
         "scene: 'no_such_scene' is neither a built-in scene (free_fall, spring, double_spring, \
-         dzhanibekov, planar_spinner, dumbbell, resting, door, cradle, rope_bridge, ragdoll) nor an existing file"
+         dzhanibekov, planar_spinner, dumbbell, resting, door, cradle, rope_bridge, ragdoll, pyramid, pendulum_chain) nor an existing file"
     );
 }
 
