@@ -28,6 +28,9 @@ if ! cmp -s "$out/viewer.js" viewer/dist/viewer.js; then
     exit 1
 fi
 
-cargo build --locked -q -p tumble-cli --bin tumble
+# The binary `cargo test` builds for the CLI's tests (test profile): after scripts/test.sh's
+# test run this is a no-op, where `cargo build` would compile every crate again in the
+# dev profile.
+cargo test --locked -q -p tumble-cli --no-run
 target/debug/tumble export-html viewer/test/falling.json --out "$out/falling.html" --quiet
 CHROMIUM="$chromium" node viewer/test/browser.mjs "$out/falling.html" "$out"
