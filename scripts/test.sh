@@ -37,3 +37,6 @@ fi
 CARGO_PROFILE_RELEASE_DEBUG=0 VIRTUAL_ENV="$PWD/$venv" PATH="$PWD/$venv/bin:$PATH" \
     "$venv/bin/maturin" develop --release --locked --quiet
 MPLBACKEND=Agg "$venv/bin/python" -m pytest -q crates/tumble-py/tests
+
+step "web viewer in headless Chromium (scripts/browser-test.sh; screenshots in target/browser-test/)"
+bash scripts/browser-test.sh

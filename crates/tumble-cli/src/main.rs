@@ -6,9 +6,14 @@
 
 mod analyze;
 mod contacts;
+mod plot;
+mod progress;
 mod record;
+mod render;
 mod report;
 mod run;
+mod sample;
+mod web;
 
 use std::io::{self, Write};
 use std::process::ExitCode;
@@ -45,13 +50,28 @@ enum Command {
     Run(Box<run::RunArgs>),
     /// Measure every integrator: observed order of convergence and energy behaviour on a
     /// harmonic oscillator, and the largest stable step on a stiff spring; print a table.
-    Analyze,
+    Analyze(analyze::AnalyzeArgs),
     /// List the built-in scenes with their descriptions.
     Scenes,
     /// Print the contact points of a scene's initial state as CSV:
     /// body_a,body_b,x,y,z,nx,ny,nz,separation (normal from body_a to body_b, separation
     /// in m, negative when penetrating; x,y,z midway between the two surfaces).
     Contacts(contacts::ContactsArgs),
+    /// Draw a run as pictures, with no display and no GPU: an animated GIF, one PNG, a
+    /// folder of numbered PNG frames, or an MP4 (with ffmpeg). Every body drawn solid and
+    /// shaded in its own colour (or the scene's `color`), planes as a ground grid, the
+    /// time in the top-left corner.
+    Render(render::RenderArgs),
+    /// Plot the columns of a CSV file against its first column as PNG, e.g. the energies
+    /// and momenta of `tumble run --diagnostics diag.csv`: energies in one panel, the other
+    /// columns in a second.
+    Plot(plot::PlotArgs),
+    /// Write one self-contained HTML file that plays the run in a browser (no network
+    /// needed): orbit camera, play, pause, speed, a time scrubber, click a body for its
+    /// position, velocity, ω and L, and live plots of the energies and |L|.
+    ExportHtml(web::ExportArgs),
+    /// Serve the page of `export-html` on localhost and open it in the browser.
+    View(web::ViewArgs),
 }
 
 /// Why the program stops early.
@@ -86,9 +106,13 @@ fn main() -> ExitCode {
     let command = cli.command.unwrap_or_else(|| Command::Run(Box::default()));
     let result = match command {
         Command::Run(args) => run::run(&args),
-        Command::Analyze => analyze::analyze(),
+        Command::Analyze(args) => analyze::analyze(&args),
+        Command::Plot(args) => plot::plot(&args),
+        Command::ExportHtml(args) => web::export(&args),
+        Command::View(args) => web::view(&args),
         Command::Scenes => report::list_scenes(),
         Command::Contacts(args) => contacts::contacts(&args),
+        Command::Render(args) => render::render(&args),
     };
     match result {
         Ok(()) | Err(Failure::Closed) => ExitCode::SUCCESS,

@@ -19,9 +19,9 @@ pub const SEED_SCENE: &str = "free_fall";
 #[derive(Args, Debug)]
 pub struct RunArgs {
     /// Scene to run: a built-in name (free_fall, spring, double_spring, dzhanibekov,
-    /// planar_spinner, dumbbell, resting, door, cradle, rope_bridge, ragdoll; see `tumble
-    /// scenes`) or the path of a JSON scene file
-    /// (format: docs/scene-format.md). Built-in names win over files in the current
+    /// planar_spinner, dumbbell, resting, door, cradle, rope_bridge, ragdoll, pyramid,
+    /// pendulum_chain; see `tumble scenes`) or the path of a JSON scene file (format:
+    /// docs/scene-format.md). Built-in names win over files in the current
     /// directory. Omitted: the seed's free fall, printed as a table against the analytic
     /// solution.
     #[arg(value_name = "SCENE")]
@@ -87,7 +87,8 @@ pub struct RunArgs {
     #[arg(long, value_name = "K", default_value_t = 1)]
     pub every: u64,
 
-    /// Print nothing on standard output (errors still go to standard error).
+    /// Print nothing on standard output and show no progress bar (errors still go to
+    /// standard error).
     #[arg(long, short)]
     pub quiet: bool,
 }
@@ -130,7 +131,15 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
     apply_solver_options(args, &mut scene.world)?;
     let plan = plan(args, &scene)?;
     let mut sinks = Sinks::open(args, &scene, &plan)?;
-    step_all(&mut scene.world, &plan, args.every, &mut sinks)?;
+    let mut progress = crate::progress::Progress::new(plan.steps, "running", args.quiet);
+    step_all(
+        &mut scene.world,
+        &plan,
+        args.every,
+        &mut sinks,
+        &mut progress,
+    )?;
+    progress.finish();
     sinks.finish(&scene, &plan)
 }
 
@@ -163,6 +172,7 @@ fn step_all(
     plan: &RunPlan,
     every: u64,
     sinks: &mut Sinks,
+    progress: &mut crate::progress::Progress,
 ) -> Result<(), Failure> {
     sinks.observe(0, 0.0, world, true)?;
     for k in 1..=plan.steps {
@@ -171,6 +181,7 @@ fn step_all(
             .map_err(|e| Failure::Runtime(format!("step {k}: {e}")))?;
         let record = k % every == 0 || k == plan.steps;
         sinks.observe(k, plan.time_after(k), world, record)?;
+        progress.inc(1);
     }
     Ok(())
 }

@@ -5,7 +5,7 @@ use tumble::{BodyDef, BodyKind, InertiaSpec, MassSpec, Mat3, Quat, Shape, Vec3};
 use crate::error::{printable, Result};
 use crate::reader::{Node, Obj};
 
-const BODY_KEYS: [&str; 17] = [
+const BODY_KEYS: [&str; 18] = [
     "name",
     "kind",
     "shape",
@@ -23,7 +23,27 @@ const BODY_KEYS: [&str; 17] = [
     "friction",
     "restitution",
     "bullet",
+    "color",
 ];
+
+/// A body's `color`, `"#rrggbb"`: for pictures and the viewer only, never for physics.
+pub(crate) fn color(node: &Node<'_>) -> Result<Option<[u8; 3]>> {
+    let obj = node.object()?;
+    let Some(text) = obj.str("color")? else {
+        return Ok(None);
+    };
+    let hex = text
+        .strip_prefix('#')
+        .filter(|h| h.len() == 6 && h.is_ascii());
+    let channel = |i: usize| hex.and_then(|h| u8::from_str_radix(&h[i..i + 2], 16).ok());
+    match (channel(0), channel(2), channel(4)) {
+        (Some(r), Some(g), Some(b)) => Ok(Some([r, g, b])),
+        _ => Err(obj.err_at(
+            "color",
+            format!("expected \"#rrggbb\", got '{}'", printable(text)),
+        )),
+    }
+}
 
 /// The body kinds, as scene files name them.
 pub const BODY_KINDS: [&str; 3] = ["static", "kinematic", "dynamic"];

@@ -5,7 +5,7 @@
 //! file in `scenes/` is listed here.
 
 /// Name and JSON text of every built-in scene; the seed's free fall first.
-const SCENES: [(&str, &str); 11] = [
+const SCENES: [(&str, &str); 13] = [
     ("free_fall", include_str!("../../../scenes/free_fall.json")),
     ("spring", include_str!("../../../scenes/spring.json")),
     (
@@ -29,6 +29,11 @@ const SCENES: [(&str, &str); 11] = [
         include_str!("../../../scenes/rope_bridge.json"),
     ),
     ("ragdoll", include_str!("../../../scenes/ragdoll.json")),
+    ("pyramid", include_str!("../../../scenes/pyramid.json")),
+    (
+        "pendulum_chain",
+        include_str!("../../../scenes/pendulum_chain.json"),
+    ),
 ];
 
 /// The JSON text of the built-in scene `name`.

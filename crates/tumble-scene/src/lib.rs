@@ -79,6 +79,8 @@ pub struct Scene {
     /// A label per body in creation order (the order of `world.body_ids()`): its name, or
     /// its index in `bodies` when it has none. Used to label output rows.
     pub body_names: Vec<String>,
+    /// Each body's `color` as RGB, creation order; `None` where the scene gives none.
+    pub body_colors: Vec<Option<[u8; 3]>>,
 }
 
 impl Scene {
@@ -173,7 +175,7 @@ fn build(root: &Node<'_>) -> Result<Scene> {
     // Checked now, so a bad value is reported as the scene's, not when a run starts.
     plan::check_settings(duration, dt)?;
     let mut world = World::try_new(&def).map_err(|e| SceneError::from_engine(e, ""))?;
-    let body_names = add_bodies(&obj, &mut world)?;
+    let (body_names, body_colors) = add_bodies(&obj, &mut world)?;
     add_forces(&obj, &mut world)?;
     add_joints(&obj, &mut world)?;
     Ok(Scene {
@@ -183,6 +185,7 @@ fn build(root: &Node<'_>) -> Result<Scene> {
         dt,
         duration,
         body_names,
+        body_colors,
     })
 }
 
@@ -253,19 +256,23 @@ fn integrator(obj: &Obj<'_>) -> Result<Integrator> {
     }
 }
 
-fn add_bodies(obj: &Obj<'_>, world: &mut World) -> Result<Vec<String>> {
+/// Creates the bodies; returns their labels and colours.
+#[allow(clippy::type_complexity)]
+fn add_bodies(obj: &Obj<'_>, world: &mut World) -> Result<(Vec<String>, Vec<Option<[u8; 3]>>)> {
     let Some(bodies) = obj.get("bodies") else {
-        return Ok(Vec::new());
+        return Ok((Vec::new(), Vec::new()));
     };
     let mut names = Vec::new();
+    let mut colors = Vec::new();
     for (i, node) in bodies.array()?.iter().enumerate() {
         let (def, shape) = body::body(node)?;
+        colors.push(body::color(node)?);
         names.push(def.name.clone().unwrap_or_else(|| i.to_string()));
         world
             .create_body(&def, shape)
             .map_err(|e| SceneError::from_engine(e, node.path()))?;
     }
-    Ok(names)
+    Ok((names, colors))
 }
 
 fn add_joints(obj: &Obj<'_>, world: &mut World) -> Result<()> {

@@ -45,7 +45,7 @@ fn misspelt_keys_are_refused_with_the_allowed_ones() {
         error(&one_body(r#""velocty": [1, 0, 0]"#)),
         "bodies[0].velocty: unknown key (expected one of: name, kind, shape, mass, density, \
          inertia, center_of_mass, position, orientation, velocity, angular_velocity, planar, \
-         collision_group, collision_mask, friction, restitution, bullet)"
+         collision_group, collision_mask, friction, restitution, bullet, color)"
     );
     assert_eq!(
         error(&with_forces(
@@ -299,6 +299,20 @@ fn missing_required_keys_are_named() {
 }
 
 #[test]
+fn colours_must_be_hex_triplets() {
+    for bad in [r#""red""#, r##""#ff00""##, r##""#gg0000""##, "[1, 0, 0]"] {
+        let e = error(&one_body(&format!(r#""color": {bad}"#)));
+        assert!(e.starts_with("bodies[0].color: expected "), "{bad}: {e}");
+    }
+    let scene = tumble_scene::load_str(
+        r##"{"bodies": [{"color": "#FF8000", "shape": {"type": "sphere", "radius": 1}},
+                         {"shape": {"type": "sphere", "radius": 1}}]}"##,
+    )
+    .unwrap();
+    assert_eq!(scene.body_colors, [Some([255, 128, 0]), None]);
+}
+
+#[test]
 fn files_that_cannot_be_read_are_reported() {
     let e = tumble_scene::load_file("/no/such/scene.json").unwrap_err();
     assert_eq!(e.field, "scene");
@@ -310,7 +324,7 @@ fn files_that_cannot_be_read_are_reported() {
     assert_eq!(
         e.to_string(),
         "scene: 'no_such_scene' is neither a built-in scene (free_fall, spring, double_spring, \
-         dzhanibekov, planar_spinner, dumbbell, resting, door, cradle, rope_bridge, ragdoll) nor an existing file"
+         dzhanibekov, planar_spinner, dumbbell, resting, door, cradle, rope_bridge, ragdoll, pyramid, pendulum_chain) nor an existing file"
     );
 }
 

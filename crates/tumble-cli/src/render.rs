@@ -1,0 +1,231 @@
+//! `tumble render SCENE --out FILE`: pictures of a run, with no display and no GPU.
+
+use std::path::PathBuf;
+
+use std::io::Write;
+
+use clap::Args;
+use glam::Vec3;
+use tumble::Real;
+use tumble_render::{Camera, Encoder, Model, Output, Overlays, Renderer, Rgb, Snapshot};
+use tumble_scene::{printable, RunPlan, SceneError};
+
+use crate::progress::Progress;
+use crate::sample::{frame_count, run_frames};
+use crate::Failure;
+
+/// The most frames one command draws (an hour at 30 fps).
+const MAX_FRAMES: u64 = 108_000;
+
+/// Options of `tumble render`.
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Scene: a built-in name (see `tumble scenes`) or a JSON scene file.
+    #[arg(value_name = "SCENE")]
+    pub scene: String,
+
+    /// Where to write: FILE.gif (animation), FILE.png (one picture of the state at the end
+    /// of --duration; --duration 0 for the initial state), FILE.mp4 (needs ffmpeg on the
+    /// PATH), or a folder (a path with no extension, or an existing directory) of numbered
+    /// PNG frames frame_00000.png, frame_00001.png, ...
+    #[arg(long, value_name = "PATH")]
+    pub out: PathBuf,
+
+    /// Simulated time to show, in seconds (s); default: the scene's `duration`.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    pub duration: Option<Real>,
+
+    /// Frames per second of simulated time (and of playback).
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 30.0,
+        allow_negative_numbers = true
+    )]
+    pub fps: Real,
+
+    /// Picture width in pixels.
+    #[arg(long, value_name = "PX", default_value_t = 480)]
+    pub width: u32,
+
+    /// Picture height in pixels.
+    #[arg(long, value_name = "PX", default_value_t = 360)]
+    pub height: u32,
+
+    /// Eye position x,y,z (m, world frame). Default: framing every moving body over the
+    /// whole run, seen from +z, a little to the right and above.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub camera: Option<String>,
+
+    /// Point the camera looks at, x,y,z (m). Default: the middle of the moving bodies'
+    /// reach over the run.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub target: Option<String>,
+
+    /// Mark contact points (red dots).
+    #[arg(long)]
+    pub contacts: bool,
+
+    /// Draw joints: a line between the two anchors and the joint axis (orange).
+    #[arg(long)]
+    pub joints: bool,
+
+    /// Print nothing on standard output and show no progress bar.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// A point given on the command line as `x,y,z`.
+pub fn parse_point(field: &str, text: &str) -> Result<Vec3, SceneError> {
+    let parts: Vec<Option<f32>> = text
+        .split(',')
+        .map(|p| p.trim().parse::<f32>().ok().filter(|x| x.is_finite()))
+        .collect();
+    match parts[..] {
+        [Some(x), Some(y), Some(z)] => Ok(Vec3::new(x, y, z)),
+        _ => Err(SceneError::new(
+            field,
+            format!("expected three numbers x,y,z, got '{}'", printable(text)),
+        )),
+    }
+}
+
+/// The options checked before anything runs.
+struct Checked {
+    output: Output,
+    plan: RunPlan,
+    frames: u64,
+    eye: Option<Vec3>,
+    target: Option<Vec3>,
+}
+
+fn check(args: &RenderArgs, scene: &tumble_scene::Scene) -> Result<Checked, Failure> {
+    if !(args.fps > 0.0 && args.fps <= 1000.0) {
+        return Err(SceneError::new("fps", "must be > 0 and <= 1000").into());
+    }
+    for (field, px) in [("width", args.width), ("height", args.height)] {
+        if !(16..=8192).contains(&px) {
+            return Err(SceneError::new(field, "must be between 16 and 8192 pixels").into());
+        }
+    }
+    let output = Output::from_path(&args.out).map_err(|e| SceneError::new("out", e))?;
+    let plan = RunPlan::from_duration(args.duration.unwrap_or(scene.duration), scene.dt)?;
+    let frames = frame_count(&plan, args.fps);
+    if frames > MAX_FRAMES && !output.single_frame() {
+        return Err(SceneError::new(
+            "duration",
+            format!("{frames} frames at this --fps; at most {MAX_FRAMES}"),
+        )
+        .into());
+    }
+    let eye = args
+        .camera
+        .as_deref()
+        .map(|t| parse_point("camera", t))
+        .transpose()?;
+    let target = args
+        .target
+        .as_deref()
+        .map(|t| parse_point("target", t))
+        .transpose()?;
+    if eye.is_some() && eye == target {
+        return Err(SceneError::new("camera", "must differ from --target").into());
+    }
+    Ok(Checked {
+        output,
+        plan,
+        frames,
+        eye,
+        target,
+    })
+}
+
+/// Runs the command.
+pub fn render(args: &RenderArgs) -> Result<(), Failure> {
+    let mut scene = tumble_scene::load(&args.scene)?;
+    let c = check(args, &scene)?;
+    let colours: Vec<Option<Rgb>> = scene.body_colors.iter().map(|c| c.map(Rgb)).collect();
+
+    let mut progress = Progress::new(c.plan.steps, "simulating", args.quiet);
+    let mut snapshots = Vec::with_capacity(c.frames.min(MAX_FRAMES) as usize);
+    let keep_all = !c.output.single_frame();
+    run_frames(
+        &mut scene.world,
+        &c.plan,
+        args.fps,
+        &mut progress,
+        |world, k| {
+            if keep_all || k + 1 == c.frames {
+                snapshots.push(Snapshot::capture(world));
+            }
+            Ok(())
+        },
+    )?;
+    progress.finish();
+
+    let (camera, scale) = camera(&scene.world, &colours, &snapshots, args, &c);
+    let model = Model::new(&scene.world, &colours, scale / 12.0);
+    let overlays = Overlays {
+        contacts: args.contacts,
+        joints: args.joints,
+        time: true,
+    };
+    let renderer = Renderer::new(model, camera, overlays, scale);
+    let out_failure = |e: std::io::Error| {
+        Failure::Input(format!(
+            "out: cannot write '{}': {e}",
+            printable(&args.out.display().to_string())
+        ))
+    };
+    let mut encoder = Encoder::create(&c.output, args.width, args.height, narrow(args.fps))
+        .map_err(out_failure)?;
+    let mut progress = Progress::new(snapshots.len() as u64, "drawing", args.quiet);
+    for s in &snapshots {
+        encoder.frame(&renderer.render(s)).map_err(out_failure)?;
+        progress.inc(1);
+    }
+    progress.finish();
+    encoder.finish().map_err(out_failure)?;
+    if !args.quiet {
+        let what = if c.output.single_frame() {
+            "picture"
+        } else {
+            "frames"
+        };
+        writeln!(
+            std::io::stdout(),
+            "wrote '{}' ({} {what}, {}x{} px)",
+            printable(&args.out.display().to_string()),
+            snapshots.len(),
+            args.width,
+            args.height
+        )
+        .map_err(crate::stdout_failure)?;
+    }
+    Ok(())
+}
+
+/// The camera the options ask for, or one framing the run; and the size of what is in
+/// view (m), which sets the ground grid and how finely shapes are cut.
+fn camera(
+    world: &tumble::World,
+    colours: &[Option<Rgb>],
+    snapshots: &[Snapshot],
+    args: &RenderArgs,
+    c: &Checked,
+) -> (Camera, f32) {
+    // A coarse model is enough to find the bounds: only radii are used.
+    let bounds = Model::new(world, colours, f32::INFINITY).bounds(snapshots);
+    let (min, max) = bounds.unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)));
+    let auto = Camera::framing(min, max, args.width, args.height);
+    let target = c.target.unwrap_or(auto.target);
+    let eye = c.eye.unwrap_or(target + (auto.eye - auto.target));
+    let camera = Camera::look_at(eye, target, args.width, args.height).unwrap_or(auto);
+    let scale = (max - min).length().max(0.5);
+    (camera, scale)
+}
+
+#[allow(clippy::unnecessary_cast)] // a no-op in the f32 build
+fn narrow(x: Real) -> f32 {
+    x as f32
+}
