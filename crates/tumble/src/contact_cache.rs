@@ -278,24 +278,12 @@ impl ContactCache {
         self.touching.dedup();
         let (now, before) = (&self.touching, &self.touching_before);
         self.events.clear();
-        for &(a, b) in now {
-            if before.binary_search(&(a, b)).is_err() {
-                self.events.push(ContactEvent {
-                    kind: ContactEventKind::Begin,
-                    body_a: a,
-                    body_b: b,
-                });
-            }
-        }
-        for &(a, b) in before {
-            if now.binary_search(&(a, b)).is_err() {
-                self.events.push(ContactEvent {
-                    kind: ContactEventKind::End,
-                    body_a: a,
-                    body_b: b,
-                });
-            }
-        }
+        // Both lists are sorted: one merge-like walk per direction finds what is missing
+        // from the other, where a binary search per pair was a third of the update's time.
+        self.events
+            .extend(missing(now, before, ContactEventKind::Begin));
+        self.events
+            .extend(missing(before, now, ContactEventKind::End));
     }
 
     /// The contacts, for the solver to store impulses in.
@@ -424,6 +412,25 @@ impl Sorted<'_> {
             .map(|k| self.at(k))
             .take_while(move |c| (c.body_a, c.body_b) == (a, b))
     }
+}
+
+/// The pairs of sorted `list` absent from sorted `other`, as events of `kind`.
+fn missing<'a>(
+    list: &'a [(BodyId, BodyId)],
+    other: &'a [(BodyId, BodyId)],
+    kind: ContactEventKind,
+) -> impl Iterator<Item = ContactEvent> + 'a {
+    let mut k = 0;
+    list.iter().filter_map(move |&pair| {
+        while other.get(k).is_some_and(|&p| p < pair) {
+            k += 1;
+        }
+        (other.get(k) != Some(&pair)).then_some(ContactEvent {
+            kind,
+            body_a: pair.0,
+            body_b: pair.1,
+        })
+    })
 }
 
 /// Carries the previous contacts of the pair (a, b) over unchanged.

@@ -100,12 +100,4 @@ impl BodySim {
             self.w_synced = state.w;
         }
     }
-
-    /// The inverse effective mass of this body along direction `n` at offset `r`:
-    /// n·M⁻¹n + (r×n)·I⁻¹(r×n).
-    #[inline]
-    pub fn inverse_mass_along(&self, n: Vec3, r: Vec3) -> Real {
-        let rn = r.cross(n);
-        self.inv_mass * (self.linear_mask * n).dot(n) + rn.dot(self.inv_inertia * rn)
-    }
 }

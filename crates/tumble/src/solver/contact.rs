@@ -52,12 +52,25 @@ struct Row {
 }
 
 impl Row {
+    /// Each side's I⁻¹(r × d) serves both the row and its effective mass,
+    /// n·M⁻¹n + (r×n)·I⁻¹(r×n), so it is computed once. Bodies the solver does not move
+    /// (zero inverse mass and inertia) are not skipped: a branch on which side is the
+    /// ground mispredicts, and was measured slower than the arithmetic.
+    #[inline]
     fn new(d: Vec3, ra: Vec3, rb: Vec3, a: &BodySim, b: &BodySim) -> Row {
-        let k = a.inverse_mass_along(d, ra) + b.inverse_mass_along(d, rb);
-        let (ang_a, ang_b) = (ra.cross(d), rb.cross(d));
+        let side = |s: &BodySim, r: Vec3| {
+            let ang = r.cross(d);
+            let turn = s.inv_inertia * ang;
+            (
+                turn,
+                s.inv_mass * (s.linear_mask * d).dot(d) + ang.dot(turn),
+            )
+        };
+        let ((turn_a, ka), (turn_b, kb)) = (side(a, ra), side(b, rb));
+        let k = ka + kb;
         Row {
-            turn_a: a.inv_inertia * ang_a,
-            turn_b: b.inv_inertia * ang_b,
+            turn_a,
+            turn_b,
             mass: if k > 0.0 { 1.0 / k } else { 0.0 },
         }
     }
