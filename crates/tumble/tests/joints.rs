@@ -642,3 +642,41 @@ fn slider_limits_springs_and_distance_ropes_behave() {
     }
     assert!(longest < 1.01, "the rope stretched to {longest} m");
 }
+
+#[test]
+fn a_pendulum_bouncing_off_a_wall_never_gains_energy() {
+    // The bob swings on its joint alone (split half kicks) and then touches a wall (the
+    // whole kick of contacts), switching scheme twice a period. Contacts with e = 0.5
+    // only take energy away: the total must never rise above its starting value by more
+    // than the joint's 0.5 % swing-energy wobble.
+    let (mut w, ball, m, _) = hinge_pendulum(1.0, 1.0);
+    w.create_body(
+        &BodyDef {
+            kind: BodyKind::Static,
+            position: Vec3::new(-0.45, -1.0, 0.0),
+            restitution: 0.5,
+            ..Default::default()
+        },
+        Shape::cuboid(Vec3::new(0.05, 0.5, 0.5)),
+    )
+    .unwrap();
+    let e0 = energy(&w, ball);
+    let scale = m * G * (1.0 - (1.0 as Real).cos());
+    let mut touched = 0;
+    let mut highest = e0;
+    for _ in 0..600 {
+        w.step(1.0 / 60.0).unwrap();
+        highest = highest.max(energy(&w, ball));
+        touched += usize::from(w.contacts().iter().any(|c| !c.manifold.is_empty()));
+    }
+    assert!(touched > 10, "the bob never reached the wall");
+    assert!(
+        highest - e0 < 0.005 * scale,
+        "energy rose by {} J of {scale}",
+        highest - e0
+    );
+    assert!(
+        energy(&w, ball) < e0 - 0.1 * scale,
+        "the bounces took no energy"
+    );
+}
