@@ -13,7 +13,7 @@
 
 use crate::error::{check, Error, Result};
 use crate::id::BodyId;
-use crate::math::{Quat, Real, Vec3};
+use crate::math::{orthonormal_basis, Quat, Real, Vec3};
 
 /// Handle of a joint in a [`crate::World`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -309,12 +309,6 @@ fn check_spring(field: &str, s: &JointSpring) -> Result<()> {
     check::finite(&format!("{field}.target"), s.target)
 }
 
-/// A unit vector perpendicular to unit `v`, chosen from v alone.
-pub(crate) fn perpendicular(v: Vec3) -> Vec3 {
-    let other = if v.x.abs() < 0.6 { Vec3::X } else { Vec3::Y };
-    v.cross(other).normalize()
-}
-
 /// Builds the world's record of a checked definition, given the bodies' poses now
 /// (`None`: the world, identity).
 pub(crate) fn build(def: &JointDef, body: (Vec3, Quat), other: Option<(Vec3, Quat)>) -> Joint {
@@ -322,12 +316,12 @@ pub(crate) fn build(def: &JointDef, body: (Vec3, Quat), other: Option<(Vec3, Qua
     let other_axis = def.other_axis.normalize();
     let (pa, qa) = body;
     let (pb, qb) = other.unwrap_or((Vec3::ZERO, Quat::IDENTITY));
-    let reference = perpendicular(axis);
+    let reference = orthonormal_basis(axis)[0];
     // The same direction in the other frame, made perpendicular to its axis.
     let seen = qb.inverse() * (qa * reference);
     let other_reference = (seen - other_axis * other_axis.dot(seen))
         .try_normalize()
-        .unwrap_or_else(|| perpendicular(other_axis));
+        .unwrap_or_else(|| orthonormal_basis(other_axis)[0]);
     let world_a = pa + qa * def.anchor;
     let world_b = pb + qb * def.other_anchor;
     let length = match def.kind {

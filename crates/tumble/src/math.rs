@@ -57,6 +57,19 @@ pub fn skew(a: Vec3) -> Mat3 {
     )
 }
 
+/// Two unit vectors completing unit `n` to a right-handed orthonormal basis
+/// (t₁ × t₂ = n), chosen from n alone so the result does not depend on history and has no
+/// branch but the sign of n.z (Duff et al., "Building an orthonormal basis, revisited").
+pub fn orthonormal_basis(n: Vec3) -> [Vec3; 2] {
+    let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    [
+        Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        Vec3::new(b, sign + n.y * n.y * a, -n.y),
+    ]
+}
+
 /// The outer product `a bᵀ`.
 #[inline]
 pub fn outer(a: Vec3, b: Vec3) -> Mat3 {

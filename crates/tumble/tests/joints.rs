@@ -562,11 +562,12 @@ fn ball_joint_cone_and_twist_limits_hold() {
         let down = q * -Vec3::Y;
         swing = swing.max(down.angle_between(-Vec3::Y));
         // Twist as the joint defines it: the angle between the two frames' reference
-        // directions (z, perpendicular to the axis), both laid into the plane across the
-        // axes' mean direction.
+        // directions (the first of `orthonormal_basis(axis)`), both laid into the plane
+        // across the axes' mean direction.
         let mid = (down - Vec3::Y).normalize();
         let flat = |r: Vec3| (r - mid * mid.dot(r)).normalize();
-        let (r_rod, r_world) = (flat(q * Vec3::Z), flat(Vec3::Z));
+        let reference = tumble::math::orthonormal_basis(-Vec3::Y)[0];
+        let (r_rod, r_world) = (flat(q * reference), flat(reference));
         twist = twist.max(
             mid.dot(r_world.cross(r_rod))
                 .atan2(r_rod.dot(r_world))

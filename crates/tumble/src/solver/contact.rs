@@ -17,7 +17,7 @@ use super::body::{BodySim, BodyState};
 use super::softness::Softness;
 use crate::contact_cache::Contact;
 use crate::geometry::Pose;
-use crate::math::{Real, Vec3};
+use crate::math::{orthonormal_basis, Real, Vec3};
 
 /// How position error turns into velocity in one substep.
 #[derive(Debug, Clone, Copy)]
@@ -233,18 +233,6 @@ const REPLAY_ITERATIONS: usize = 4;
 /// Speed changes below this fraction of the restitution threshold count as none.
 pub(crate) const TOLERANCE: Real = 1e-4;
 
-/// Two unit vectors completing `n` to a right-handed basis, chosen from n alone so the
-/// result does not depend on history (Duff et al., "Building an orthonormal basis").
-pub(crate) fn tangent_basis(n: Vec3) -> [Vec3; 2] {
-    let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
-    let a = -1.0 / (sign + n.z);
-    let b = n.x * n.y * a;
-    [
-        Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
-        Vec3::new(b, sign + n.y * n.y * a, -n.y),
-    ]
-}
-
 /// The two bodies' states, mutably; `a != b` always (a body never touches itself).
 fn pair(states: &mut [BodyState], a: usize, b: usize) -> Option<(&mut BodyState, &mut BodyState)> {
     let [x, y] = states.get_disjoint_mut([a, b]).ok()?;
@@ -267,7 +255,7 @@ impl ContactConstraint {
         let m = &contact.manifold;
         let (sa, sb) = (&sims[a], &sims[b]);
         let normal = m.normal;
-        let tangents = tangent_basis(normal);
+        let tangents = orthonormal_basis(normal);
         let dirs = [normal, tangents[0], tangents[1]];
         let push = |s: &BodySim, k: usize| s.linear_mask * dirs[k] * s.inv_mass;
         let c = ContactConstraint {

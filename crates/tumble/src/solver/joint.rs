@@ -24,8 +24,8 @@
 
 use super::body::{BodySim, BodyState};
 use super::softness::Softness;
-use crate::joint::{perpendicular, Joint, JointImpulses, JointKind, JointSpring, Motor};
-use crate::math::{Mat3, Quat, Real, Vec3};
+use crate::joint::{Joint, JointImpulses, JointKind, JointSpring, Motor};
+use crate::math::{orthonormal_basis, Mat3, Quat, Real, Vec3};
 
 /// A body as a joint sees it: pose, inverse masses, whether it moves. The world is one
 /// that never moves, at the origin.
@@ -353,16 +353,14 @@ impl JointConstraint {
         match self.kind {
             JointKind::Hinge { .. } => {
                 let (ha, hb) = (fr.sa.q * self.axis_a, fr.sb.q * self.axis_b);
-                let b1 = perpendicular(ha);
-                let b2 = ha.cross(b1);
+                let [b1, b2] = orthonormal_basis(ha);
                 let error = ha.cross(hb);
                 hard.push(Row::angular(b1), b1.dot(error));
                 hard.push(Row::angular(b2), b2.dot(error));
             }
             JointKind::Slider { .. } => {
                 let axis = self.axis(fr);
-                let p1 = perpendicular(axis);
-                for p in [p1, axis.cross(p1)] {
+                for p in orthonormal_basis(axis) {
                     let row = Row {
                         lin: p,
                         ang_a: (fr.ra + fr.d).cross(p),
@@ -451,7 +449,9 @@ impl JointConstraint {
         let (ta, tb) = (fr.sa.q * self.axis_a, fr.sb.q * self.axis_b);
         let swing = ta.cross(tb);
         let angle = swing.length().atan2(ta.dot(tb));
-        let n = swing.try_normalize().unwrap_or_else(|| perpendicular(ta));
+        let n = swing
+            .try_normalize()
+            .unwrap_or_else(|| orthonormal_basis(ta)[0]);
         // The margin shrinks as b swings away about n: Ċ = −n·(ω_b − ω_a).
         Some((Row::angular(n).negated(), cone - angle))
     }
