@@ -177,6 +177,11 @@ impl JointConstraint {
         }
     }
 
+    /// Dense indices of the two bodies (`None`: the world).
+    pub fn bodies(&self) -> [Option<usize>; 2] {
+        [self.a, self.b]
+    }
+
     /// Whether the solver moves either body.
     pub fn active(&self, sims: &[BodySim]) -> bool {
         [self.a, self.b]

@@ -19,6 +19,7 @@
 mod body;
 mod contact;
 mod joint;
+mod mass_ratio;
 mod restitution;
 mod softness;
 
@@ -34,6 +35,7 @@ use crate::force::Wrench;
 use crate::integrate::{exact_spin, rotor_drift, Motion, System};
 use crate::joint::Joint;
 use crate::math::{Mat3, Real, Vec3};
+use std::ops::Range;
 
 /// Which velocity solver handles contacts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -133,6 +135,13 @@ pub(crate) struct Solver {
     constraints: Vec<ContactConstraint>,
     points: Points,
     joints: Vec<JointConstraint>,
+    /// Per body, whether its island has a large mass ratio (see `mass_ratio`); empty when
+    /// none has. Such islands' contacts and joints sit at the end of their lists, from
+    /// `heavy_contacts` and `heavy_joints`, and get `heavy_passes` times the passes.
+    heavy: Vec<bool>,
+    heavy_contacts: usize,
+    heavy_joints: usize,
+    heavy_passes: u32,
     /// Bodies whose kick is split around the drift (see `split_kicks`).
     split_kick: Vec<bool>,
     wrench: Vec<Wrench>,
@@ -160,6 +169,7 @@ impl Solver {
         }
         self.start_states.clone_from(&self.states);
         let rule = bias_rule(input.settings, input.scales, h);
+        self.find_heavy_islands(contacts, input.ghosts, input.joints, input.joint_bodies);
         self.prepare(contacts, input.ghosts);
         self.prepare_joints(bodies, input.joints, input.joint_bodies);
         let (solve_pass, relax_pass) = joint_passes(input.settings, h);
@@ -174,30 +184,15 @@ impl Solver {
             for c in &self.constraints {
                 c.warm_start(&self.points.hot, &mut self.states);
             }
-            // The substep's impulses are final once the last pass has visited a
-            // manifold, so that pass adds them to the step's totals on its way instead
-            // of a separate walk over every point.
             let iterations = input.settings.iterations;
             let relax = input.settings.kind == SolverKind::SoftStep && iterations > 0;
-            for k in 0..iterations {
-                let totals = !relax && k + 1 == iterations;
-                for j in &mut self.joints {
-                    j.solve(&self.sims, &mut self.states, &solve_pass);
-                }
-                self.solve_pass(&rule, true, totals);
-            }
+            self.passes(iterations, (&rule, &solve_pass), true, !relax);
             self.drift(bodies, h);
             if any_split {
                 self.kick(input.system, t + h, h, true, true);
             }
             if relax {
-                for k in 0..iterations {
-                    let totals = k + 1 == iterations;
-                    for j in &mut self.joints {
-                        j.solve(&self.sims, &mut self.states, &relax_pass);
-                    }
-                    self.solve_pass(&rule, false, totals);
-                }
+                self.passes(iterations, (&rule, &relax_pass), false, true);
             }
             if iterations == 0 {
                 ContactConstraint::add_to_totals(&self.points.hot, &mut self.points.cold);
@@ -240,10 +235,74 @@ impl Solver {
         }
     }
 
+    /// `iterations` passes over the joints then the contacts, with `bias` or without
+    /// (relax); islands with a large mass ratio get two or three times as many. The substep's impulses
+    /// are final once the last pass has visited a manifold, so with `totals` that pass adds
+    /// them to the step's totals on its way instead of a separate walk over every point.
+    fn passes(
+        &mut self,
+        iterations: u32,
+        rules: (&BiasRule, &JointPass),
+        bias: bool,
+        totals: bool,
+    ) {
+        let (rule, joint_pass) = rules;
+        let parts = [
+            (0..self.heavy_contacts, 0..self.heavy_joints, iterations),
+            (
+                self.heavy_contacts..self.constraints.len(),
+                self.heavy_joints..self.joints.len(),
+                self.heavy_passes * iterations,
+            ),
+        ];
+        for (contacts, joints, count) in parts {
+            for k in 0..count {
+                for j in &mut self.joints[joints.clone()] {
+                    j.solve(&self.sims, &mut self.states, joint_pass);
+                }
+                let last = totals && k + 1 == count;
+                self.solve_pass(contacts.clone(), rule, bias, last);
+            }
+        }
+    }
+
+    /// Marks the bodies of islands with a large mass ratio (see `mass_ratio`), over the
+    /// contacts and joints the step will solve.
+    fn find_heavy_islands(
+        &mut self,
+        contacts: &[Contact],
+        ghosts: &[bool],
+        joints: &[Joint],
+        joint_bodies: &[[Option<usize>; 2]],
+    ) {
+        let touching = contacts
+            .iter()
+            .enumerate()
+            .filter(|&(i, c)| !idle(c, i, ghosts))
+            .map(|(_, c)| (c.index_a as usize, c.index_b as usize));
+        let joined =
+            joints
+                .iter()
+                .zip(joint_bodies)
+                .filter_map(|(j, link)| match (j.broken, *link) {
+                    (false, [Some(a), Some(b)]) => Some((a, b)),
+                    _ => None,
+                });
+        (self.heavy, self.heavy_passes) =
+            mass_ratio::heavy_islands(&self.sims, touching.chain(joined)).unwrap_or_default();
+    }
+
+    /// Whether body `k` is in an island with a large mass ratio.
+    fn is_heavy(&self, k: usize) -> bool {
+        self.heavy.get(k).copied().unwrap_or(false)
+    }
+
     fn prepare(&mut self, contacts: &[Contact], ghosts: &[bool]) {
         self.constraints.clear();
         self.points.clear();
-        for (colour, i) in self.colour_order(contacts, ghosts) {
+        let order = self.colour_order(contacts, ghosts);
+        self.heavy_contacts = order.partition_point(|&(heavy, _, _)| !heavy);
+        for (_, colour, i) in order {
             let c = &contacts[i];
             let (a, b) = (c.index_a as usize, c.index_b as usize);
             let (sa, sb) = (&self.sims[a], &self.sims[b]);
@@ -304,19 +363,30 @@ impl Solver {
                 self.joints.push(c);
             }
         }
+        // Joints of islands with a large mass ratio go last, in creation order, for their
+        // extra passes (see `passes`); the others keep their order.
+        let flags = &self.heavy;
+        let heavy = |c: &JointConstraint| {
+            let heavy = |k: usize| flags.get(k).copied().unwrap_or(false);
+            c.bodies().into_iter().flatten().any(heavy)
+        };
+        let (mut light, heavy): (Vec<_>, Vec<_>) = self.joints.drain(..).partition(|c| !heavy(c));
+        self.heavy_joints = light.len();
+        light.extend(heavy);
+        self.joints = light;
     }
 
     /// The contacts to solve, ordered so that neighbours in the list rarely share a moving
     /// body (greedy graph colouring, colour by colour). Gauss–Seidel passes are a chain of
     /// dependent updates; constraints on disjoint bodies let the processor overlap them.
     /// Deterministic: colours depend only on the contacts' order, itself deterministic.
-    fn colour_order(&self, contacts: &[Contact], ghosts: &[bool]) -> Vec<(u32, usize)> {
+    /// Contacts of islands with a large mass ratio come last, for their extra passes.
+    fn colour_order(&self, contacts: &[Contact], ghosts: &[bool]) -> Vec<(bool, u32, usize)> {
         let mut used = vec![0u64; self.sims.len()];
         let mut coloured = Vec::with_capacity(contacts.len());
         for (i, c) in contacts.iter().enumerate() {
             let (a, b) = (c.index_a as usize, c.index_b as usize);
-            let idle = c.manifold.is_empty() || ghosts.get(i).copied().unwrap_or(false);
-            if idle || !(self.sims[a].moves || self.sims[b].moves) {
+            if idle(c, i, ghosts) || !(self.sims[a].moves || self.sims[b].moves) {
                 continue;
             }
             let mask = |k: usize| if self.sims[k].moves { used[k] } else { 0 };
@@ -326,7 +396,7 @@ impl Solver {
                     used[k] |= 1u64 << colour;
                 }
             }
-            coloured.push((colour, i));
+            coloured.push((self.is_heavy(a) || self.is_heavy(b), colour, i));
         }
         coloured.sort_unstable();
         coloured
@@ -334,9 +404,9 @@ impl Solver {
 
     /// One pass over every constraint, in colour order; neighbours of one colour are
     /// solved two at a time (see `ContactConstraint::solve_two`).
-    fn solve_pass(&mut self, rule: &BiasRule, bias: bool, totals: bool) {
-        let cs = &self.constraints;
-        let mut i = 0;
+    fn solve_pass(&mut self, range: Range<usize>, rule: &BiasRule, bias: bool, totals: bool) {
+        let cs = &self.constraints[..range.end];
+        let mut i = range.start;
         while i < cs.len() {
             match cs.get(i + 1).filter(|next| cs[i].pairs_with(next)) {
                 Some(next) => {
@@ -418,6 +488,11 @@ impl Solver {
             state.dr = Mat3::from_quat(sim.q * sim.q0.inverse());
         }
     }
+}
+
+/// Whether contact `i` sits the step out: no points, or a speculative ghost.
+fn idle(c: &Contact, i: usize, ghosts: &[bool]) -> bool {
+    c.manifold.is_empty() || ghosts.get(i).copied().unwrap_or(false)
 }
 
 /// How joints treat drift in the solve and the relax passes: the joint spring (capped at
