@@ -6,11 +6,19 @@
 //! ```sh
 //! cargo run --release -p tumble-bench --bin quick -- pyramid 5
 //! ```
+//!
+//! `landing` is the rain's steps 30–90 (as the criterion bench `peers` times them: the
+//! bodies land and pile), with the checksum at step 90.
 
 use tumble_bench::{
     count_rain, measure_pyramid, median, pyramid, rain, timed_steps, tumble_engine, Simulation,
     PYRAMID_SETTLE_STEPS, PYRAMID_TIMED_STEPS, RAIN_TIMED_STEPS,
 };
+
+/// The landing window: steps skipped, then timed (the criterion bench's `RAIN_SKIP` and
+/// `RAIN_TIMED`).
+const LANDING_SKIP: usize = 30;
+const LANDING_TIMED: usize = 60;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -18,7 +26,14 @@ fn main() {
     let runs: usize = args.get(1).and_then(|n| n.parse().ok()).unwrap_or(3);
     let mut means = Vec::new();
     for _ in 0..runs {
-        let (mean, note, positions) = if scene == "rain" {
+        let (mean, note, positions) = if scene == "landing" {
+            let mut sim = tumble_engine::build(&rain());
+            for _ in 0..LANDING_SKIP {
+                sim.step();
+            }
+            let t = timed_steps(&mut sim, LANDING_TIMED);
+            (t.mean(), String::new(), sim.dynamic_positions())
+        } else if scene == "rain" {
             let mut sim = tumble_engine::build(&rain());
             let t = timed_steps(&mut sim, RAIN_TIMED_STEPS);
             let p = sim.dynamic_positions();
