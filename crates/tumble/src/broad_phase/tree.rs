@@ -130,18 +130,21 @@ impl Tree {
     /// passed in so repeated queries reuse one allocation.
     pub fn query(&self, aabb: &Aabb, stack: &mut Vec<u32>, mut f: impl FnMut(u32)) {
         stack.clear();
-        if self.root != NULL {
+        if self.root != NULL && self.nodes[self.root as usize].aabb.overlaps(aabb) {
             stack.push(self.root);
         }
+        // Children are tested before they are pushed: most are rejected, and a rejected
+        // one then costs no trip through the stack. Leaves come out in the same order.
         while let Some(i) = stack.pop() {
             let n = &self.nodes[i as usize];
-            if !n.aabb.overlaps(aabb) {
-                continue;
-            }
             if n.is_leaf() {
                 f(n.children[1]);
-            } else {
-                stack.extend_from_slice(&n.children);
+                continue;
+            }
+            for c in n.children {
+                if self.nodes[c as usize].aabb.overlaps(aabb) {
+                    stack.push(c);
+                }
             }
         }
     }
