@@ -18,7 +18,7 @@ use crate::ccd::shape_toi;
 use crate::contact_cache::Contact;
 use crate::geometry::{Convex, Pose};
 use crate::math::{Real, Vec3};
-use crate::narrow_phase::closest_points;
+use crate::narrow_phase::within;
 use crate::query::Sweep;
 use crate::shape::Shape;
 
@@ -98,7 +98,7 @@ fn is_ghost(bodies: &[Body], c: &Contact, gravity: Vec3, dt: Real, slop: Real) -
 /// `near` and the target keeps the answer the sweep's to far beyond rounding.
 fn meet_by_the_end(a: &Shape, sa: &Sweep, b: &Shape, sb: &Sweep, near: Real) -> bool {
     match (Convex::from_shape(a), Convex::from_shape(b)) {
-        (Some(ca), Some(cb)) => closest_points(&ca, &sa.at(1.0), &cb, &sb.at(1.0)).distance <= near,
+        (Some(ca), Some(cb)) => within(&ca, &sa.at(1.0), &cb, &sb.at(1.0), near),
         _ => false,
     }
 }

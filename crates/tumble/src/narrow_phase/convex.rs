@@ -766,6 +766,25 @@ pub fn closest_points(a: &Convex, pa: &Pose, b: &Convex, pb: &Pose) -> ClosestPo
     }
 }
 
+/// Whether convex `a` at `pa` and `b` at `pb` are at most `limit` apart, overlapping
+/// included: [`closest_points`]`.distance <= limit`, by GJK alone, stopped once it proves
+/// the answer either way. Overlapping cores need no depth (the separating-axis test that
+/// `closest_points` runs for them, with its polytopes, was most of the cost of asking this
+/// about bodies that end a sweep interpenetrating).
+pub(crate) fn within(a: &Convex, pa: &Pose, b: &Convex, pb: &Pose, limit: Real) -> bool {
+    let pair = Pair::new(a, pa, b, pb);
+    if !pair.is_finite() || !pa.position.is_finite() || !pa.rotation.is_finite() {
+        return false;
+    }
+    let rounding = a.radius() + b.radius();
+    let g = gjk(&pair, limit + rounding);
+    match g.status {
+        Status::BeyondCutoff => false,
+        Status::Overlap => true,
+        Status::Separated => g.distance() - rounding <= limit,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
