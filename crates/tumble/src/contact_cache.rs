@@ -149,6 +149,8 @@ pub(crate) struct ContactCache {
     /// The contact keys of `previous` in that order: searches read these 24 bytes, not
     /// a cache line of each kilobyte-sized contact.
     keys: Vec<Key>,
+    /// Scratch for sorting `keys` with their indices.
+    keyed: Vec<(Key, u32)>,
     events: Vec<ContactEvent>,
     pairs: Vec<(u32, u32)>,
     manifolds: Vec<Manifold>,
@@ -207,13 +209,7 @@ impl ContactCache {
         broad.pairs(&mut self.pairs);
         let statics = bodies.iter().filter(|b| b.kind == BodyKind::Static).count();
         std::mem::swap(&mut self.contacts, &mut self.previous);
-        self.order.clear();
-        self.order.extend(0..self.previous.len() as u32);
-        let previous = &self.previous;
-        self.order.sort_by_key(|&i| previous[i as usize].key());
-        self.keys.clear();
-        self.keys
-            .extend(self.order.iter().map(|&i| previous[i as usize].key()));
+        self.index_previous();
         let old = Sorted {
             list: &self.previous,
             order: &self.order,
@@ -243,6 +239,17 @@ impl ContactCache {
                 keep_previous(&old, ids[a], ids[b], a, b, &mut self.contacts);
                 continue;
             }
+            // The broad phase pairs fat boxes, stretched along each body's motion: as the
+            // rain lands, six pairs in seven are farther apart than the margin. Every
+            // routine reports only points closer than `margin`, and a gap between the
+            // tight boxes is a lower bound of the distance, so a pair whose tight boxes
+            // stand more than twice the margin apart (room to spare over rounding) has no
+            // manifold, and is passed over without asking the narrow phase. Nor can it have
+            // a manifold to reuse: that needs a gap under the margin a few µm ago.
+            let mut tight = |i: usize| *self.tight.get_or_insert(i, &bodies[i]);
+            if apart(&tight(a), &tight(b), 2.0 * margin) {
+                continue;
+            }
             let (pa, pb) = (body_a.pose(), body_b.pose());
             if reusable(&body_a.shape) && reusable(&body_b.shape) {
                 if let Some(c) = old.find((ids[a], ids[b], 0, 0)).filter(|c| {
@@ -259,16 +266,6 @@ impl ContactCache {
                     warm_start(contact, &old, (&pa, &pb));
                     continue;
                 }
-            }
-            // The broad phase pairs fat boxes, stretched along each body's motion: as the
-            // rain lands, six pairs in seven are farther apart than the margin. Every
-            // routine reports only points closer than `margin`, and a gap between the
-            // tight boxes is a lower bound of the distance, so a pair whose tight boxes
-            // stand more than twice the margin apart (room to spare over rounding) has no
-            // manifold, and is passed over without asking the narrow phase.
-            let mut tight = |i: usize| *self.tight.get_or_insert(i, &bodies[i]);
-            if apart(&tight(a), &tight(b), 2.0 * margin) {
-                continue;
             }
             self.manifolds.clear();
             collide(
@@ -299,6 +296,21 @@ impl ContactCache {
             }
         }
         self.find_events();
+    }
+
+    /// Sorts `previous` by key into `order` and `keys`. Keys are read once, in list order,
+    /// and sorted with their indices: a sort that fetched each key from its kilobyte-sized
+    /// contact missed the cache per comparison.
+    fn index_previous(&mut self) {
+        self.keyed.clear();
+        self.keyed
+            .extend(self.previous.iter().zip(0..).map(|(c, i)| (c.key(), i)));
+        // Stable, as the sort of indices it replaces was.
+        self.keyed.sort_by_key(|&(key, _)| key);
+        self.order.clear();
+        self.order.extend(self.keyed.iter().map(|&(_, i)| i));
+        self.keys.clear();
+        self.keys.extend(self.keyed.iter().map(|&(key, _)| key));
     }
 
     /// Begin and end events since the previous update, by body pair.
