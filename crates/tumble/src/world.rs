@@ -109,6 +109,8 @@ pub struct World {
     pub(crate) broad_phase: BroadPhase,
     /// One broad-phase proxy per body, in body order.
     pub(crate) proxies: Vec<ProxyId>,
+    /// Scratch for `store_motions`: the moved proxies' new tight boxes and displacements.
+    proxy_updates: Vec<(ProxyId, crate::geometry::Aabb, Vec3)>,
     contacts: ContactCache,
     /// Joints in creation order, with their handles (see `world_joints.rs`).
     pub(crate) joints: Vec<Joint>,
@@ -167,6 +169,7 @@ impl World {
             sleep_tag: 0,
             broad_phase: BroadPhase::new(Tolerances::new(def.length_unit).aabb_margin),
             proxies: Vec::new(),
+            proxy_updates: Vec::new(),
             contacts: ContactCache::default(),
             joints: Vec::new(),
             joint_ids: Vec::new(),
@@ -650,12 +653,15 @@ impl World {
 
     /// Writes the step's results into the bodies and their broad-phase proxies.
     fn store_motions(&mut self, motions: &[Motion]) {
+        // Handed to the broad phase together: it may rebuild its tree rather than move
+        // most of its leaves one by one.
+        self.proxy_updates.clear();
         for ((body, m), proxy) in self.bodies.iter_mut().zip(motions).zip(&self.proxies) {
             if body.kind != BodyKind::Static && body.awake {
                 let moved = m.x - body.com;
                 let pose = crate::geometry::Pose::new(m.x - m.q * body.local_center, m.q);
-                self.broad_phase
-                    .update(*proxy, body.shape.aabb(&pose), moved);
+                self.proxy_updates
+                    .push((*proxy, body.shape.aabb(&pose), moved));
             }
             body.com = m.x;
             body.orientation = m.q;
@@ -663,6 +669,7 @@ impl World {
             body.angular_momentum = m.l;
             body.angular_velocity = m.w;
         }
+        self.broad_phase.update_many(&self.proxy_updates);
     }
 
     /// Speculative contact distance (m).
