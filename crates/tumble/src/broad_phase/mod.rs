@@ -165,6 +165,8 @@ pub struct BroadPhase {
     found: Vec<PairEntry>,
     merged: Vec<PairEntry>,
     stack: Vec<u32>,
+    /// Scratch for `Tree::self_pairs`.
+    pair_stack: Vec<(u32, u32)>,
     /// Scratch for `update_many`: per tree, the leaves to reinsert with their new boxes.
     pending: [Vec<(u32, Aabb)>; 2],
 }
@@ -320,8 +322,7 @@ impl BroadPhase {
             }
         }
         for (tree, moves) in self.trees.iter_mut().zip(&pending) {
-            let leaves = tree.leaf_count();
-            if moves.len() >= REBUILD_MIN && moves.len() as Real >= REBUILD_SHARE * leaves as Real {
+            if is_burst(moves.len(), tree.leaf_count()) {
                 tree.rebuild_with(moves, &mut self.stack);
             } else {
                 for &(node, fresh) in moves {
@@ -349,6 +350,7 @@ impl BroadPhase {
             found,
             merged,
             stack,
+            pair_stack,
             ..
         } = self;
         // Every pair whose fat boxes may have changed, or whose proxy is gone, renamed or
@@ -357,6 +359,20 @@ impl BroadPhase {
             pairs.retain(|e| !bit(moved, e.a) && !bit(moved, e.b));
         }
         found.clear();
+        // When a large share of the moving proxies moved (a burst, see `update_many`), one
+        // walk of the moving tree against itself finds their pairs with each other for
+        // less than a query per proxy; pairs of two unmoved proxies are kept already.
+        let moving = tree_index(ProxyKind::Moving);
+        let burst = is_burst(move_buffer.len(), trees[moving].leaf_count());
+        if burst {
+            trees[moving].self_pairs(pair_stack, |x, y| {
+                let (p, q) = (&proxies[x as usize], &proxies[y as usize]);
+                let fresh = bit(moved, x) || bit(moved, y);
+                if fresh && p.user != q.user && p.filter.allows(&q.filter) {
+                    found.push(PairEntry::new(x, p.user, y, q.user));
+                }
+            });
+        }
         for &id in move_buffer.iter() {
             let p = &proxies[id as usize];
             if p.node == NULL {
@@ -373,7 +389,9 @@ impl BroadPhase {
                     found.push(PairEntry::new(id, p.user, other, q.user));
                 }
             };
-            trees[tree_index(ProxyKind::Moving)].query(&fat, stack, &mut visit);
+            if !(burst && p.kind == ProxyKind::Moving) {
+                trees[moving].query(&fat, stack, &mut visit);
+            }
             if p.kind == ProxyKind::Moving {
                 trees[tree_index(ProxyKind::Static)].query(&fat, stack, &mut visit);
             }
@@ -531,6 +549,12 @@ impl BroadPhase {
             fat
         }
     }
+}
+
+/// Whether `moved` of a tree's `leaves` is a burst: at least [`REBUILD_MIN`] and
+/// [`REBUILD_SHARE`] of them.
+fn is_burst(moved: usize, leaves: usize) -> bool {
+    moved >= REBUILD_MIN && moved as Real >= REBUILD_SHARE * leaves as Real
 }
 
 /// Bit `i` of a bit set.

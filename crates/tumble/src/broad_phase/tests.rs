@@ -240,3 +240,26 @@ fn batched_updates_rebuild_or_move_and_keep_the_pairs_exact() {
     // 300 leaves rebuilt by halves: ⌈log2 300⌉ = 9.
     assert!(bp.tree_heights()[1] <= 12, "{:?}", bp.tree_heights());
 }
+
+#[test]
+fn self_pairs_match_brute_force() {
+    let mut rng = Rng(9);
+    let mut tree = Tree::default();
+    let boxes: Vec<Aabb> = (0..400).map(|_| rng.aabb(15.0)).collect();
+    for (i, b) in boxes.iter().enumerate() {
+        tree.insert(*b, i as u32);
+    }
+    let mut got = Vec::new();
+    tree.self_pairs(&mut Vec::new(), |a, b| got.push((a.min(b), a.max(b))));
+    got.sort_unstable();
+    let mut want = Vec::new();
+    for i in 0..boxes.len() {
+        for j in i + 1..boxes.len() {
+            if boxes[i].overlaps(&boxes[j]) {
+                want.push((i as u32, j as u32));
+            }
+        }
+    }
+    assert!(!want.is_empty());
+    assert_eq!(got, want, "each overlapping pair exactly once");
+}

@@ -231,6 +231,47 @@ impl Tree {
         }
     }
 
+    /// Calls `f(a, b)` once for every pair of distinct leaves whose boxes overlap (their
+    /// items, in no particular order), by descending the tree against itself: one walk
+    /// where a query per leaf would descend from the root for each. `stack` is scratch;
+    /// an entry (x, x) stands for the pairs within subtree x.
+    pub fn self_pairs(&self, stack: &mut Vec<(u32, u32)>, mut f: impl FnMut(u32, u32)) {
+        stack.clear();
+        if self.root != NULL {
+            stack.push((self.root, self.root));
+        }
+        while let Some((a, b)) = stack.pop() {
+            let (na, nb) = (&self.nodes[a as usize], &self.nodes[b as usize]);
+            if a == b {
+                if !na.is_leaf() {
+                    let [l, r] = na.children;
+                    stack.extend_from_slice(&[(l, l), (r, r), (l, r)]);
+                }
+                continue;
+            }
+            if !na.aabb.overlaps(&nb.aabb) {
+                continue;
+            }
+            // Split the larger box (a leaf cannot be split), so the two sides stay alike.
+            let split_a = match (na.is_leaf(), nb.is_leaf()) {
+                (true, true) => {
+                    f(na.children[1], nb.children[1]);
+                    continue;
+                }
+                (true, false) => false,
+                (false, true) => true,
+                (false, false) => area(&na.aabb) >= area(&nb.aabb),
+            };
+            if split_a {
+                let [c0, c1] = na.children;
+                stack.extend_from_slice(&[(c0, b), (c1, b)]);
+            } else {
+                let [c0, c1] = nb.children;
+                stack.extend_from_slice(&[(a, c0), (a, c1)]);
+            }
+        }
+    }
+
     fn alloc(&mut self, node: Node) -> u32 {
         if self.free != NULL {
             let i = self.free;
