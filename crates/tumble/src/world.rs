@@ -102,6 +102,8 @@ pub struct World {
     solver: Solver,
     start: Vec<Motion>,
     solved: Vec<bool>,
+    /// Bodies whose integrator result is replaced this step (solved or asleep).
+    discarded: Vec<bool>,
     /// Contacts the solver leaves out this step (see `speculative.rs`).
     ghosts: Vec<bool>,
     sleep_enabled: bool,
@@ -164,6 +166,7 @@ impl World {
             solver: Solver::default(),
             start: Vec::new(),
             solved: Vec::new(),
+            discarded: Vec::new(),
             ghosts: Vec::new(),
             sleep_enabled: def.sleep,
             sleep_tag: 0,
@@ -567,14 +570,22 @@ impl World {
             .zip(&self.solved)
             .any(|(b, s)| b.kind == BodyKind::Dynamic && b.awake && !s);
         if free {
+            // Their results are replaced below: the solver's or the start's.
+            self.discarded.clear();
+            self.discarded.extend(
+                self.bodies
+                    .iter()
+                    .zip(&self.solved)
+                    .map(|(b, &solved)| solved || !b.awake),
+            );
             integrate::advance(
                 self.integrator,
                 &mut system,
                 &mut motions,
                 &mut self.verlet,
-                self.time,
-                dt,
+                (self.time, dt),
                 &mut self.scratch,
+                &self.discarded,
             );
         } else {
             integrate::move_kinematic(self.bodies.as_slice(), &mut motions, dt);
