@@ -160,6 +160,8 @@ pub(crate) struct ContactCache {
     touching_before: Vec<(BodyId, BodyId)>,
     /// The bodies' tight boxes, computed as pairs need them.
     tight: TightBoxes,
+    /// Scratch for broad-phase queries.
+    stack: Vec<u32>,
 }
 
 /// Each body's tight box at its current pose, computed once per update on first use.
@@ -278,7 +280,8 @@ impl ContactCache {
             );
             if statics > 1 {
                 for m in &mut self.manifolds {
-                    drop_covered_points(m, (a, b), bodies, broad, margin * 0.25);
+                    let stack = &mut self.stack;
+                    drop_covered_points(m, (a, b), bodies, (broad, stack), margin * 0.25);
                 }
                 self.manifolds.retain(|m| !m.is_empty());
             }
@@ -387,7 +390,7 @@ fn drop_covered_points(
     m: &mut Manifold,
     (a, b): (usize, usize),
     bodies: &[Body],
-    broad: &BroadPhase,
+    (broad, stack): (&BroadPhase, &mut Vec<u32>),
     nudge: Real,
 ) {
     let (sa, sb) = (
@@ -399,11 +402,11 @@ fn drop_covered_points(
     }
     // Outward from the static body: +n if it is A (the normal points from A to B).
     let (fixed, out) = if sa { (a, m.normal) } else { (b, -m.normal) };
-    let covered = |surface: Vec3| {
+    let mut covered = |surface: Vec3| {
         let probe = surface + out * nudge;
         let mut inside = false;
         // Static bodies have static proxies only.
-        broad.query_static_aabb(&Aabb::new(probe, probe), |user| {
+        broad.query_static_aabb_with(&Aabb::new(probe, probe), stack, |user| {
             let k = user as usize;
             if !inside && k != fixed {
                 if let Some(other) = bodies.get(k).filter(|o| o.kind == BodyKind::Static) {

@@ -417,10 +417,20 @@ impl BroadPhase {
 
     /// Calls `f(user)` for every static proxy whose box overlaps `aabb`: the moving tree,
     /// which holds nearly every proxy, is not walked.
-    pub fn query_static_aabb(&self, aabb: &Aabb, mut f: impl FnMut(u32)) {
-        let mut stack = Vec::new();
+    pub fn query_static_aabb(&self, aabb: &Aabb, f: impl FnMut(u32)) {
+        self.query_static_aabb_with(aabb, &mut Vec::new(), f);
+    }
+
+    /// [`BroadPhase::query_static_aabb`] with the caller's scratch `stack`, for callers
+    /// that query once per contact point and would otherwise allocate each time.
+    pub fn query_static_aabb_with(
+        &self,
+        aabb: &Aabb,
+        stack: &mut Vec<u32>,
+        mut f: impl FnMut(u32),
+    ) {
         self.trees[tree_index(ProxyKind::Static)]
-            .query(aabb, &mut stack, |id| f(self.proxies[id as usize].user));
+            .query(aabb, stack, |id| f(self.proxies[id as usize].user));
     }
 
     /// Calls `f(user)` for every proxy whose enlarged box overlaps `aabb` (static proxies
