@@ -60,8 +60,7 @@ fn is_ghost(bodies: &[Body], c: &Contact, gravity: Vec3, dt: Real, slop: Real) -
     }
     let (kick_a, kick_b) = (kick(a, gravity, dt), kick(b, gravity, dt));
     let n = c.manifold.normal;
-    // A point at r from the centre moves along n at (ω × r)·n = r·(n × ω).
-    let spin = |body: &Body| n.cross(body.angular_velocity).length() * reach(body);
+    let spin = |body: &Body| body.angular_velocity.length() * reach(body);
     let approach = (a.velocity - b.velocity)
         .dot(n)
         .max((a.velocity + kick_a - b.velocity - kick_b).dot(n))
@@ -117,14 +116,9 @@ fn kick(body: &Body, gravity: Vec3, dt: Real) -> Vec3 {
     }
 }
 
-/// How far any point of the body's surface that turning moves lies from its centre of
-/// mass, at most: a sphere turning about its own centre moves no surface.
+/// How far any point of the body lies from its centre of mass, at most.
 fn reach(body: &Body) -> Real {
-    let turning = match body.shape {
-        Shape::Sphere { .. } => 0.0,
-        _ => body.shape.bounding_radius(),
-    };
-    turning + body.local_center.length()
+    body.shape.bounding_radius() + body.local_center.length()
 }
 
 /// The body's motion over the step, velocity and spin held, plus half gravity's kick.

@@ -4,17 +4,10 @@
 //! normal n between the shapes (GJK, `narrow_phase::closest_points`). The separation along
 //! the *fixed* axis n, s_n(τ) = min_B x·n − max_A x·n, equals d at τ = t and never exceeds
 //! the true distance at any τ. A point of A at offset r from its centre moves with
-//! v_A + ω_A × r, so its speed along n is at most v_A·n + |n × ω_A|·ρ_A, since
-//! (ω × r)·n = r·(n × ω), with ρ_A the largest |r| over the shape's *core*: the rounding of
-//! a sphere or capsule turns into itself and moves no part of the surface. Likewise for B.
-//! Hence
+//! v_A + ω_A × r, so its speed along n is at most v_A·n + |ω_A|·ρ_A, ρ_A the largest |r|
+//! over the shape; likewise for B. Hence
 //!
-//!   ds_n/dτ ≥ −((v_A − v_B)·n + |n × ω_A|·ρ_A + |n × ω_B|·ρ_B) = −μ,
-//!
-//! (A bound with |ω|·ρ over the whole shape holds too, but a ball rolling on a box, or a
-//! box spinning about the normal, then seems to close the gap at up to its rim speed, and
-//! each step covers a fraction of the gap: as the rain lands, ghost checks took eleven steps
-//! on average, with |n × ω| and the core eight.)
+//!   ds_n/dτ ≥ −((v_A − v_B)·n + |ω_A|·ρ_A + |ω_B|·ρ_B) = −μ,
 //!
 //! and the shapes cannot come within `target` before τ = t + (d − target)/μ. Stepping there
 //! never passes the first contact; each step re-measures d and n. If μ ≤ 0 the gap along n
@@ -90,10 +83,9 @@ pub fn time_of_impact(
     if !target.is_finite() || !sweep_a.is_finite() || !sweep_b.is_finite() {
         return None;
     }
-    // Reach of each shape's core about its centre of rotation: the rounding (a sphere's or
-    // capsule's radius) turns into itself and moves no surface.
-    let reach_a = reach(a, sweep_a.local_center) - a.radius();
-    let reach_b = reach(b, sweep_b.local_center) - b.radius();
+    // Reach of each shape about its centre of rotation times its angular travel.
+    let spin_a = reach(a, sweep_a.local_center) * sweep_a.rotation.length();
+    let spin_b = reach(b, sweep_b.local_center) * sweep_b.rotation.length();
     let dv = sweep_a.translation - sweep_b.translation;
     let size = reach(a, Vec3::ZERO) + reach(b, Vec3::ZERO);
     let mut t: Real = 0.0;
@@ -112,11 +104,7 @@ pub fn time_of_impact(
         if c.distance <= target + tol || iteration == MAX_ITERATIONS {
             return Some(toi);
         }
-        // A point at r from the centre moves along n at (ω × r)·n = r·(n × ω): only the
-        // spin across n counts.
-        let spin = |rotation: Vec3, reach: Real| c.normal.cross(rotation).length() * reach;
-        let mu =
-            dv.dot(c.normal) + spin(sweep_a.rotation, reach_a) + spin(sweep_b.rotation, reach_b);
+        let mu = dv.dot(c.normal) + spin_a + spin_b;
         if mu.is_nan() || mu <= 0.0 {
             return None;
         }
