@@ -149,6 +149,8 @@ pub(crate) struct ContactCache {
     /// The contact keys of `previous` in that order: searches read these 24 bytes, not
     /// a cache line of each kilobyte-sized contact.
     keys: Vec<Key>,
+    /// Scratch for sorting `keys` with their indices.
+    keyed: Vec<(Key, u32)>,
     events: Vec<ContactEvent>,
     pairs: Vec<(u32, u32)>,
     manifolds: Vec<Manifold>,
@@ -156,6 +158,38 @@ pub(crate) struct ContactCache {
     /// list is this one's `before`, so each update sorts only its own.
     touching: Vec<(BodyId, BodyId)>,
     touching_before: Vec<(BodyId, BodyId)>,
+    /// The bodies' tight boxes, computed as pairs need them.
+    tight: TightBoxes,
+    /// Scratch for broad-phase queries.
+    stack: Vec<u32>,
+}
+
+/// Each body's tight box at its current pose, computed once per update on first use.
+#[derive(Debug, Default)]
+struct TightBoxes {
+    boxes: Vec<Option<Aabb>>,
+}
+
+impl TightBoxes {
+    fn clear(&mut self, bodies: usize) {
+        self.boxes.clear();
+        self.boxes.resize(bodies, None);
+    }
+
+    fn get_or_insert(&mut self, i: usize, body: &Body) -> &Aabb {
+        self.boxes[i].get_or_insert_with(|| body.shape.aabb(&body.pose()))
+    }
+}
+
+/// Whether the boxes are more than `gap` apart along some axis. NaN compares false: such a
+/// pair is left to the narrow phase.
+fn apart(a: &Aabb, b: &Aabb, gap: Real) -> bool {
+    a.min.x - b.max.x > gap
+        || b.min.x - a.max.x > gap
+        || a.min.y - b.max.y > gap
+        || b.min.y - a.max.y > gap
+        || a.min.z - b.max.z > gap
+        || b.min.z - a.max.z > gap
 }
 
 impl ContactCache {
@@ -177,13 +211,7 @@ impl ContactCache {
         broad.pairs(&mut self.pairs);
         let statics = bodies.iter().filter(|b| b.kind == BodyKind::Static).count();
         std::mem::swap(&mut self.contacts, &mut self.previous);
-        self.order.clear();
-        self.order.extend(0..self.previous.len() as u32);
-        let previous = &self.previous;
-        self.order.sort_by_key(|&i| previous[i as usize].key());
-        self.keys.clear();
-        self.keys
-            .extend(self.order.iter().map(|&i| previous[i as usize].key()));
+        self.index_previous();
         let old = Sorted {
             list: &self.previous,
             order: &self.order,
@@ -191,6 +219,7 @@ impl ContactCache {
             hint: std::cell::Cell::new(0),
         };
         self.contacts.clear();
+        self.tight.clear(bodies.len());
         for &(a, b) in &self.pairs {
             let (a, b) = (a as usize, b as usize);
             let (Some(body_a), Some(body_b)) = (bodies.get(a), bodies.get(b)) else {
@@ -210,6 +239,17 @@ impl ContactCache {
                 |b: &Body| b.kind == BodyKind::Static || (b.kind == BodyKind::Dynamic && !b.awake);
             if frozen(body_a) && frozen(body_b) {
                 keep_previous(&old, ids[a], ids[b], a, b, &mut self.contacts);
+                continue;
+            }
+            // The broad phase pairs fat boxes, stretched along each body's motion: as the
+            // rain lands, six pairs in seven are farther apart than the margin. Every
+            // routine reports only points closer than `margin`, and a gap between the
+            // tight boxes is a lower bound of the distance, so a pair whose tight boxes
+            // stand more than twice the margin apart (room to spare over rounding) has no
+            // manifold, and is passed over without asking the narrow phase. Nor can it have
+            // a manifold to reuse: that needs a gap under the margin a few µm ago.
+            let mut tight = |i: usize| *self.tight.get_or_insert(i, &bodies[i]);
+            if apart(&tight(a), &tight(b), 2.0 * margin) {
                 continue;
             }
             let (pa, pb) = (body_a.pose(), body_b.pose());
@@ -240,7 +280,8 @@ impl ContactCache {
             );
             if statics > 1 {
                 for m in &mut self.manifolds {
-                    drop_covered_points(m, (a, b), bodies, broad, margin * 0.25);
+                    let stack = &mut self.stack;
+                    drop_covered_points(m, (a, b), bodies, (broad, stack), margin * 0.25);
                 }
                 self.manifolds.retain(|m| !m.is_empty());
             }
@@ -258,6 +299,21 @@ impl ContactCache {
             }
         }
         self.find_events();
+    }
+
+    /// Sorts `previous` by key into `order` and `keys`. Keys are read once, in list order,
+    /// and sorted with their indices: a sort that fetched each key from its kilobyte-sized
+    /// contact missed the cache per comparison.
+    fn index_previous(&mut self) {
+        self.keyed.clear();
+        self.keyed
+            .extend(self.previous.iter().zip(0..).map(|(c, i)| (c.key(), i)));
+        // Stable, as the sort of indices it replaces was.
+        self.keyed.sort_by_key(|&(key, _)| key);
+        self.order.clear();
+        self.order.extend(self.keyed.iter().map(|&(_, i)| i));
+        self.keys.clear();
+        self.keys.extend(self.keyed.iter().map(|&(key, _)| key));
     }
 
     /// Begin and end events since the previous update, by body pair.
@@ -334,7 +390,7 @@ fn drop_covered_points(
     m: &mut Manifold,
     (a, b): (usize, usize),
     bodies: &[Body],
-    broad: &BroadPhase,
+    (broad, stack): (&BroadPhase, &mut Vec<u32>),
     nudge: Real,
 ) {
     let (sa, sb) = (
@@ -346,11 +402,11 @@ fn drop_covered_points(
     }
     // Outward from the static body: +n if it is A (the normal points from A to B).
     let (fixed, out) = if sa { (a, m.normal) } else { (b, -m.normal) };
-    let covered = |surface: Vec3| {
+    let mut covered = |surface: Vec3| {
         let probe = surface + out * nudge;
         let mut inside = false;
         // Static bodies have static proxies only.
-        broad.query_static_aabb(&Aabb::new(probe, probe), |user| {
+        broad.query_static_aabb_with(&Aabb::new(probe, probe), stack, |user| {
             let k = user as usize;
             if !inside && k != fixed {
                 if let Some(other) = bodies.get(k).filter(|o| o.kind == BodyKind::Static) {

@@ -102,6 +102,8 @@ pub struct World {
     solver: Solver,
     start: Vec<Motion>,
     solved: Vec<bool>,
+    /// Bodies whose integrator result is replaced this step (solved or asleep).
+    discarded: Vec<bool>,
     /// Contacts the solver leaves out this step (see `speculative.rs`).
     ghosts: Vec<bool>,
     sleep_enabled: bool,
@@ -109,6 +111,8 @@ pub struct World {
     pub(crate) broad_phase: BroadPhase,
     /// One broad-phase proxy per body, in body order.
     pub(crate) proxies: Vec<ProxyId>,
+    /// Scratch for `store_motions`: the moved proxies' new tight boxes and displacements.
+    proxy_updates: Vec<(ProxyId, crate::geometry::Aabb, Vec3)>,
     contacts: ContactCache,
     /// Joints in creation order, with their handles (see `world_joints.rs`).
     pub(crate) joints: Vec<Joint>,
@@ -162,11 +166,13 @@ impl World {
             solver: Solver::default(),
             start: Vec::new(),
             solved: Vec::new(),
+            discarded: Vec::new(),
             ghosts: Vec::new(),
             sleep_enabled: def.sleep,
             sleep_tag: 0,
             broad_phase: BroadPhase::new(Tolerances::new(def.length_unit).aabb_margin),
             proxies: Vec::new(),
+            proxy_updates: Vec::new(),
             contacts: ContactCache::default(),
             joints: Vec::new(),
             joint_ids: Vec::new(),
@@ -564,14 +570,22 @@ impl World {
             .zip(&self.solved)
             .any(|(b, s)| b.kind == BodyKind::Dynamic && b.awake && !s);
         if free {
+            // Their results are replaced below: the solver's or the start's.
+            self.discarded.clear();
+            self.discarded.extend(
+                self.bodies
+                    .iter()
+                    .zip(&self.solved)
+                    .map(|(b, &solved)| solved || !b.awake),
+            );
             integrate::advance(
                 self.integrator,
                 &mut system,
                 &mut motions,
                 &mut self.verlet,
-                self.time,
-                dt,
+                (self.time, dt),
                 &mut self.scratch,
+                &self.discarded,
             );
         } else {
             integrate::move_kinematic(self.bodies.as_slice(), &mut motions, dt);
@@ -650,12 +664,15 @@ impl World {
 
     /// Writes the step's results into the bodies and their broad-phase proxies.
     fn store_motions(&mut self, motions: &[Motion]) {
+        // Handed to the broad phase together: it may rebuild its tree rather than move
+        // most of its leaves one by one.
+        self.proxy_updates.clear();
         for ((body, m), proxy) in self.bodies.iter_mut().zip(motions).zip(&self.proxies) {
             if body.kind != BodyKind::Static && body.awake {
                 let moved = m.x - body.com;
                 let pose = crate::geometry::Pose::new(m.x - m.q * body.local_center, m.q);
-                self.broad_phase
-                    .update(*proxy, body.shape.aabb(&pose), moved);
+                self.proxy_updates
+                    .push((*proxy, body.shape.aabb(&pose), moved));
             }
             body.com = m.x;
             body.orientation = m.q;
@@ -663,6 +680,7 @@ impl World {
             body.angular_momentum = m.l;
             body.angular_velocity = m.w;
         }
+        self.broad_phase.update_many(&self.proxy_updates);
     }
 
     /// Speculative contact distance (m).

@@ -4,14 +4,22 @@
 //! positions, so a change that alters results beyond rounding shows at once.
 //!
 //! ```sh
-//! cargo run --release -p tumble-bench --bin quick -- pyramid 5   # or rain, joints
+//! cargo run --release -p tumble-bench --bin quick -- pyramid 5   # or rain, landing, joints
 //! ```
+//!
+//! `landing` is the rain's steps 30–90 (as the criterion bench `peers` times them: the
+//! bodies land and pile), with the checksum at step 90.
 
 use tumble_bench::{
     count_rain, joint_grid, measure_joint_grid, measure_pyramid, median, pyramid, rain,
     timed_steps, tumble_engine, Simulation, JOINT_GRID_SETTLE_STEPS, JOINT_GRID_TIMED_STEPS,
     PYRAMID_SETTLE_STEPS, PYRAMID_TIMED_STEPS, RAIN_TIMED_STEPS,
 };
+
+/// The landing window: steps skipped, then timed (the criterion bench's `RAIN_SKIP` and
+/// `RAIN_TIMED`).
+const LANDING_SKIP: usize = 30;
+const LANDING_TIMED: usize = 60;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -24,6 +32,13 @@ fn main() {
             let r = measure_joint_grid(&mut sim, JOINT_GRID_SETTLE_STEPS, JOINT_GRID_TIMED_STEPS);
             let note = format!("gap {:.2} mm", r.max_gap * 1e3);
             (r.timing.mean(), note, sim.dynamic_positions())
+        } else if scene == "landing" {
+            let mut sim = tumble_engine::build(&rain());
+            for _ in 0..LANDING_SKIP {
+                sim.step();
+            }
+            let t = timed_steps(&mut sim, LANDING_TIMED);
+            (t.mean(), String::new(), sim.dynamic_positions())
         } else if scene == "rain" {
             let mut sim = tumble_engine::build(&rain());
             let t = timed_steps(&mut sim, RAIN_TIMED_STEPS);

@@ -195,3 +195,71 @@ fn a_node_is_one_cache_line() {
     assert_eq!(std::mem::size_of::<super::tree::Node>(), 64);
     assert_eq!(std::mem::align_of::<super::tree::Node>(), 64);
 }
+
+/// Pairs of the stored boxes by brute force: (user, user), sorted.
+fn brute_pairs(bp: &BroadPhase, ids: &[(ProxyId, u32)]) -> Vec<(u32, u32)> {
+    let mut v = Vec::new();
+    for (i, &(a, ua)) in ids.iter().enumerate() {
+        for &(b, ub) in &ids[i + 1..] {
+            if bp.fat_aabb(a).unwrap().overlaps(&bp.fat_aabb(b).unwrap()) {
+                v.push((ua.min(ub), ua.max(ub)));
+            }
+        }
+    }
+    v.sort_unstable();
+    v
+}
+
+#[test]
+fn batched_updates_rebuild_or_move_and_keep_the_pairs_exact() {
+    let mut rng = Rng(5);
+    let mut bp = BroadPhase::new(0.1);
+    let ids: Vec<(ProxyId, u32)> = (0..300)
+        .map(|u| {
+            let p = bp.insert(rng.aabb(10.0), u, ProxyKind::Moving, Filter::default());
+            (p, u)
+        })
+        .collect();
+    let mut out = Vec::new();
+    bp.pairs(&mut out);
+    assert_eq!(out, brute_pairs(&bp, &ids));
+    // Every proxy moves (a rebuild), then a handful (reinsertions), then all again.
+    for moving in [300, 7, 300] {
+        let updates: Vec<(ProxyId, Aabb, Vec3)> = ids[..moving]
+            .iter()
+            .map(|&(p, _)| (p, rng.aabb(10.0), Vec3::new(0.0, -0.3, 0.0)))
+            .collect();
+        bp.update_many(&updates);
+        bp.trees[1].validate().unwrap();
+        for (p, tight, _) in &updates {
+            assert!(bp.fat_aabb(*p).unwrap().contains(tight));
+        }
+        bp.pairs(&mut out);
+        assert_eq!(out, brute_pairs(&bp, &ids));
+    }
+    // 300 leaves rebuilt by halves: ⌈log2 300⌉ = 9.
+    assert!(bp.tree_heights()[1] <= 12, "{:?}", bp.tree_heights());
+}
+
+#[test]
+fn self_pairs_match_brute_force() {
+    let mut rng = Rng(9);
+    let mut tree = Tree::default();
+    let boxes: Vec<Aabb> = (0..400).map(|_| rng.aabb(15.0)).collect();
+    for (i, b) in boxes.iter().enumerate() {
+        tree.insert(*b, i as u32);
+    }
+    let mut got = Vec::new();
+    tree.self_pairs(&mut Vec::new(), |a, b| got.push((a.min(b), a.max(b))));
+    got.sort_unstable();
+    let mut want = Vec::new();
+    for i in 0..boxes.len() {
+        for j in i + 1..boxes.len() {
+            if boxes[i].overlaps(&boxes[j]) {
+                want.push((i as u32, j as u32));
+            }
+        }
+    }
+    assert!(!want.is_empty());
+    assert_eq!(got, want, "each overlapping pair exactly once");
+}

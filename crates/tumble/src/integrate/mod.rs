@@ -233,14 +233,18 @@ const ZERO_MOTION: Motion = Motion {
 
 /// Advances `motions` (one per body of `sys`) from time `t` by `h` with `integrator`.
 /// `verlet` holds the Störmer–Verlet memory of each body and whether it is still valid.
+/// `discarded` marks bodies whose result the caller will throw away (the solver moves
+/// them, or they sleep); methods whose bodies do not read each other's intermediate
+/// states may leave them out (symplectic Euler does: as the rain lands, drifting bodies
+/// already in contact was half its cost).
 pub(crate) fn advance(
     integrator: Integrator,
     sys: &mut System<'_>,
     motions: &mut [Motion],
     verlet: &mut [Option<symplectic::VerletMemory>],
-    t: Real,
-    h: Real,
+    (t, h): (Real, Real),
     scratch: &mut Scratch,
+    discarded: &[bool],
 ) {
     scratch.start.clear();
     scratch.start.extend_from_slice(motions);
@@ -249,7 +253,9 @@ pub(crate) fn advance(
         Integrator::ExplicitEuler => explicit::explicit_euler(sys, motions, t, h, scratch),
         Integrator::Midpoint => explicit::midpoint(sys, motions, t, h, scratch),
         Integrator::Rk4 => explicit::rk4(sys, motions, t, h, scratch),
-        Integrator::SymplecticEuler => symplectic::symplectic_euler(sys, motions, t, h, scratch),
+        Integrator::SymplecticEuler => {
+            symplectic::symplectic_euler(sys, motions, t, h, scratch, discarded)
+        }
         Integrator::VelocityVerlet => symplectic::velocity_verlet(sys, motions, t, h, scratch),
         Integrator::Verlet => symplectic::verlet(sys, motions, verlet, t, h, scratch),
         Integrator::ImplicitEuler => implicit_euler::step(sys, motions, t, h, scratch),

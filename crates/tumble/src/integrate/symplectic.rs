@@ -36,16 +36,28 @@ fn drift_all(bodies: &[Body], motions: &mut [Motion], h: Real) {
 }
 
 /// v₊ = v + h F(x, v)/m, x₊ = x + h v₊ (and L₊ = L + h N, q₊ = drift(q, L₊)).
+/// Bodies marked in `discarded` are kicked but not drifted: the caller throws their
+/// result away, and no other body's step reads their drifted state.
 pub(super) fn symplectic_euler(
     sys: &mut System<'_>,
     motions: &mut [Motion],
     t: Real,
     h: Real,
     s: &mut Scratch,
+    discarded: &[bool],
 ) {
     sys.wrenches(t, motions, &mut s.wrench);
     kick(sys.bodies, motions, &s.wrench, h);
-    drift_all(sys.bodies, motions, h);
+    for ((m, body), _) in motions
+        .iter_mut()
+        .zip(sys.bodies)
+        .zip(discarded.iter().chain(std::iter::repeat(&false)))
+        .filter(|(_, &skip)| !skip)
+    {
+        m.x += m.v * h;
+        m.q = drift(body, m.q, m.l, m.w, h);
+        refresh_omega(body, m);
+    }
 }
 
 /// The seed's four steps: x₊ = x + v h + ½ a h², v½ = v + ½ a h, a₊ = F(x₊, v₊)/m,

@@ -32,7 +32,7 @@ use super::clip::{
     feature, features_contact, segment_closest, select, Arc, Feature, Polytope, EDGE, FACE, VERTEX,
 };
 use super::epa::epa;
-use super::gjk::{gjk, Pair, Status};
+use super::gjk::{gjk, Gjk, Pair, Status};
 use super::manifold::{feature_id, reduce, Candidate, FeatureId};
 use super::Manifold;
 use crate::geometry::{Convex, Pose};
@@ -182,7 +182,16 @@ pub(crate) fn deepest(
     core_b: Option<&Polytope>,
     cutoff: Real,
 ) -> Option<Deepest> {
-    let g = gjk(pair, cutoff);
+    resolve(pair, &gjk(pair, cutoff), core_a, core_b)
+}
+
+/// [`deepest`] after its GJK run `g`: the cores are only read when they overlap.
+fn resolve(
+    pair: &Pair,
+    g: &Gjk,
+    core_a: Option<&Polytope>,
+    core_b: Option<&Polytope>,
+) -> Option<Deepest> {
     match g.status {
         Status::BeyondCutoff => None,
         Status::Separated => {
@@ -731,9 +740,17 @@ pub fn closest_points(a: &Convex, pa: &Pose, b: &Convex, pb: &Pose) -> ClosestPo
             point_b: Vec3::ZERO,
         };
     }
-    let core_a = Polytope::of_core(a, &Pose::IDENTITY);
-    let core_b = Polytope::of_core(b, &pair.rel);
-    let d = deepest(&pair, core_a.as_ref(), core_b.as_ref(), Real::INFINITY).unwrap_or(Deepest {
+    // The cores as polytopes (two heap lists each) serve only overlapping cores; apart,
+    // the usual case (every step of a time-of-impact search), GJK's answer is final.
+    let g = gjk(&pair, Real::INFINITY);
+    let d = if g.status == Status::Overlap {
+        let core_a = Polytope::of_core(a, &Pose::IDENTITY);
+        let core_b = Polytope::of_core(b, &pair.rel);
+        resolve(&pair, &g, core_a.as_ref(), core_b.as_ref())
+    } else {
+        resolve(&pair, &g, None, None)
+    };
+    let d = d.unwrap_or(Deepest {
         normal: Vec3::X,
         separation: Real::INFINITY,
         point_a: Vec3::ZERO,
@@ -746,6 +763,25 @@ pub fn closest_points(a: &Convex, pa: &Pose, b: &Convex, pb: &Pose) -> ClosestPo
         normal: pa.transform_vector(d.normal),
         point_a: pa.transform_point(d.point_a + d.normal * ra),
         point_b: pa.transform_point(d.point_b - d.normal * rb),
+    }
+}
+
+/// Whether convex `a` at `pa` and `b` at `pb` are at most `limit` apart, overlapping
+/// included: [`closest_points`]`.distance <= limit`, by GJK alone, stopped once it proves
+/// the answer either way. Overlapping cores need no depth (the separating-axis test that
+/// `closest_points` runs for them, with its polytopes, was most of the cost of asking this
+/// about bodies that end a sweep interpenetrating).
+pub(crate) fn within(a: &Convex, pa: &Pose, b: &Convex, pb: &Pose, limit: Real) -> bool {
+    let pair = Pair::new(a, pa, b, pb);
+    if !pair.is_finite() || !pa.position.is_finite() || !pa.rotation.is_finite() {
+        return false;
+    }
+    let rounding = a.radius() + b.radius();
+    let g = gjk(&pair, limit + rounding);
+    match g.status {
+        Status::BeyondCutoff => false,
+        Status::Overlap => true,
+        Status::Separated => g.distance() - rounding <= limit,
     }
 }
 

@@ -161,14 +161,22 @@ impl Simplex {
         s
     }
 
-    fn from(pts: &[SupportPoint], lambda: &[Real]) -> Simplex {
-        let mut s = Simplex {
-            len: pts.len().min(4),
-            ..Default::default()
-        };
-        s.pts[..s.len].copy_from_slice(&pts[..s.len]);
-        s.lambda[..s.len].copy_from_slice(&lambda[..s.len]);
-        s
+    /// Keeps the sub-simplex `sub` of this one, with its weights. The points are moved
+    /// only when `sub` is not a prefix (a simplex is 300 bytes; copying it whole for
+    /// every candidate and step was a twelfth of a time-of-impact search).
+    fn keep(&mut self, sub: &Sub) {
+        if sub.idx[..sub.len]
+            .iter()
+            .enumerate()
+            .any(|(i, &k)| k as usize != i)
+        {
+            let old = self.pts;
+            for (p, &k) in self.pts.iter_mut().zip(&sub.idx[..sub.len]) {
+                *p = old[k as usize];
+            }
+        }
+        self.lambda = sub.lambda;
+        self.len = sub.len;
     }
 
     /// The support points.
@@ -260,23 +268,24 @@ pub(crate) fn gjk(pair: &Pair, cutoff: Real) -> Gjk {
         if s.points().iter().any(|p| p.w == w.w) {
             break Status::Separated;
         }
-        let mut next = s;
-        next.pts[next.len] = w;
-        next.len += 1;
-        let (reduced, v_new) = solve(&next);
-        if reduced.len == 4 {
-            s = reduced;
+        // Tried in place: the previous simplex is the first `len` points, unchanged.
+        s.pts[s.len] = w;
+        s.len += 1;
+        let sub = solve(&s);
+        if sub.len == 4 {
+            s.keep(&sub);
             v = Vec3::ZERO;
             break Status::Overlap;
         }
-        let vv_new = v_new.length_squared();
+        let vv_new = sub.v.length_squared();
         if vv_new.is_nan() || vv_new >= vv {
             // In exact arithmetic |v| strictly decreases; when rounding says otherwise the
             // previous simplex is as close as this precision can get.
+            s.len -= 1;
             break Status::Separated;
         }
-        s = reduced;
-        v = v_new;
+        s.keep(&sub);
+        v = sub.v;
         vv = vv_new;
     };
     Gjk {
@@ -292,45 +301,74 @@ fn same_sign(a: Real, b: Real) -> bool {
     (a > 0.0 && b > 0.0) || (a < 0.0 && b < 0.0)
 }
 
-/// The sub-simplex of `s` whose hull holds the point nearest the origin, with its weights,
-/// and that point.
-fn solve(s: &Simplex) -> (Simplex, Vec3) {
-    let p = &s.pts;
-    match s.len {
-        1 => (Simplex::single(p[0]), p[0].w),
-        2 => segment(p[0], p[1]),
-        3 => triangle(p[0], p[1], p[2]),
-        _ => tetrahedron([p[0], p[1], p[2], p[3]]),
+/// A sub-simplex: the indices of the points it keeps, their weights, and its point
+/// nearest the origin.
+#[derive(Debug, Clone, Copy)]
+struct Sub {
+    idx: [u8; 4],
+    lambda: [Real; 4],
+    len: usize,
+    v: Vec3,
+}
+
+impl Sub {
+    fn single(i: u8, w: Vec3) -> Sub {
+        Sub {
+            idx: [i, 0, 0, 0],
+            lambda: [1.0, 0.0, 0.0, 0.0],
+            len: 1,
+            v: w,
+        }
     }
 }
 
-/// Segment pq. The origin projects to p + u (q − p) with u = −p·t/t·t, t = q − p; its
-/// weights are λ_q = −p·t/t·t and λ_p = q·t/t·t (they sum to (q − p)·t/t·t = 1). A weight
-/// ≤ 0 means the projection falls beyond the other end, whose vertex is then closest.
-fn segment(p: SupportPoint, q: SupportPoint) -> (Simplex, Vec3) {
-    let t = q.w - p.w;
-    let lp = q.w.dot(t);
-    let lq = -p.w.dot(t);
+/// The sub-simplex of `s` whose hull holds the point nearest the origin, with its weights,
+/// and that point.
+fn solve(s: &Simplex) -> Sub {
+    let w = s.pts.map(|p| p.w);
+    match s.len {
+        1 => Sub::single(0, w[0]),
+        2 => segment(&w, 0, 1),
+        3 => triangle(&w, [0, 1, 2]),
+        _ => tetrahedron(&w),
+    }
+}
+
+/// Segment pq (indices into `w`). The origin projects to p + u (q − p) with
+/// u = −p·t/t·t, t = q − p; its weights are λ_q = −p·t/t·t and λ_p = q·t/t·t (they sum to
+/// (q − p)·t/t·t = 1). A weight ≤ 0 means the projection falls beyond the other end, whose
+/// vertex is then closest.
+fn segment(w: &[Vec3; 4], p: u8, q: u8) -> Sub {
+    let (wp, wq) = (w[p as usize], w[q as usize]);
+    let t = wq - wp;
+    let lp = wq.dot(t);
+    let lq = -wp.dot(t);
     if lq <= 0.0 {
-        return (Simplex::single(p), p.w);
+        return Sub::single(p, wp);
     }
     if lp <= 0.0 {
-        return (Simplex::single(q), q.w);
+        return Sub::single(q, wq);
     }
     // Dividing by the sum (not by t·t) makes the weights a partition of unity exactly.
     let sum = lp + lq;
-    let (wp, wq) = (lp / sum, lq / sum);
-    (Simplex::from(&[p, q], &[wp, wq]), p.w * wp + q.w * wq)
+    let (kp, kq) = (lp / sum, lq / sum);
+    Sub {
+        idx: [p, q, 0, 0],
+        lambda: [kp, kq, 0.0, 0.0],
+        len: 2,
+        v: wp * kp + wq * kq,
+    }
 }
 
-/// Triangle abc with normal n = (b − a) × (c − a). The origin's projection onto the plane has
-/// weights proportional to the signed areas of the sub-triangles it makes, measured along n:
-/// λ_a ∝ ((b − o) × (c − o))·n for any o on the normal line through the origin, and since o
-/// is parallel to n the o terms drop out: λ_a ∝ (b × c)·n, λ_b ∝ (c × a)·n, λ_c ∝ (a × b)·n,
-/// whose sum is ((b − a) × (c − a))·n = n·n. All of one sign: the projection is inside.
-/// Otherwise the nearest point lies on an edge facing away from a negative weight's vertex.
-fn triangle(a: SupportPoint, b: SupportPoint, c: SupportPoint) -> (Simplex, Vec3) {
-    let (wa, wb, wc) = (a.w, b.w, c.w);
+/// Triangle abc (indices into `w`) with normal n = (b − a) × (c − a). The origin's
+/// projection onto the plane has weights proportional to the signed areas of the
+/// sub-triangles it makes, measured along n: λ_a ∝ ((b − o) × (c − o))·n for any o on the
+/// normal line through the origin, and since o is parallel to n the o terms drop out:
+/// λ_a ∝ (b × c)·n, λ_b ∝ (c × a)·n, λ_c ∝ (a × b)·n, whose sum is
+/// ((b − a) × (c − a))·n = n·n. All of one sign: the projection is inside. Otherwise the
+/// nearest point lies on an edge facing away from a negative weight's vertex.
+fn triangle(w: &[Vec3; 4], t: [u8; 3]) -> Sub {
+    let (wa, wb, wc) = (w[t[0] as usize], w[t[1] as usize], w[t[2] as usize]);
     let n = (wb - wa).cross(wc - wa);
     let nn = n.length_squared();
     let cof = [
@@ -341,31 +379,33 @@ fn triangle(a: SupportPoint, b: SupportPoint, c: SupportPoint) -> (Simplex, Vec3
     let det = cof[0] + cof[1] + cof[2];
     let inside = nn > 0.0 && cof.iter().all(|&k| same_sign(det, k));
     if inside {
-        let l = [cof[0] / det, cof[1] / det, cof[2] / det];
         // The projection of the origin onto the plane, computed directly: its direction is
         // exactly the plane normal, which keeps a contact normal on a flat face exact.
-        let v = n * (wa.dot(n) / nn);
-        return (Simplex::from(&[a, b, c], &l), v);
+        return Sub {
+            idx: [t[0], t[1], t[2], 0],
+            lambda: [cof[0] / det, cof[1] / det, cof[2] / det, 0.0],
+            len: 3,
+            v: n * (wa.dot(n) / nn),
+        };
     }
-    let pts = [a, b, c];
-    let mut best: Option<(Simplex, Vec3)> = None;
+    let mut best: Option<Sub> = None;
     for k in 0..3 {
         if nn > 0.0 && same_sign(det, cof[k]) {
             continue;
         }
-        let cand = segment(pts[(k + 1) % 3], pts[(k + 2) % 3]);
-        if best.is_none_or(|(_, v)| cand.1.length_squared() < v.length_squared()) {
+        let cand = segment(w, t[(k + 1) % 3], t[(k + 2) % 3]);
+        if best.is_none_or(|b| cand.v.length_squared() < b.v.length_squared()) {
             best = Some(cand);
         }
     }
-    best.unwrap_or((Simplex::single(a), wa))
+    best.unwrap_or(Sub::single(t[0], wa))
 }
 
-/// Tetrahedron: the weight of vertex k is the signed volume of the tetrahedron with the
-/// origin in its place over the whole signed volume (their sum). All of one sign: the origin
-/// is inside. Otherwise descend into each face whose opposite weight is not of that sign.
-fn tetrahedron(p: [SupportPoint; 4]) -> (Simplex, Vec3) {
-    let w = p.map(|x| x.w);
+/// Tetrahedron of the four points of `w`: the weight of vertex k is the signed volume of
+/// the tetrahedron with the origin in its place over the whole signed volume (their sum).
+/// All of one sign: the origin is inside. Otherwise descend into each face whose opposite
+/// weight is not of that sign.
+fn tetrahedron(w: &[Vec3; 4]) -> Sub {
     let vol = |a: Vec3, b: Vec3, c: Vec3, d: Vec3| (b - a).dot((c - a).cross(d - a));
     let o = Vec3::ZERO;
     let cof = [
@@ -376,46 +416,41 @@ fn tetrahedron(p: [SupportPoint; 4]) -> (Simplex, Vec3) {
     ];
     let det = cof[0] + cof[1] + cof[2] + cof[3];
     if cof.iter().all(|&k| same_sign(det, k)) {
-        let l = cof.map(|k| k / det);
-        return (Simplex::from(&p, &l), Vec3::ZERO);
+        return Sub {
+            idx: [0, 1, 2, 3],
+            lambda: cof.map(|k| k / det),
+            len: 4,
+            v: Vec3::ZERO,
+        };
     }
-    let mut best: Option<(Simplex, Vec3)> = None;
-    for k in 0..4 {
-        if same_sign(det, cof[k]) {
+    let mut best: Option<Sub> = None;
+    for k in 0..4u8 {
+        if same_sign(det, cof[k as usize]) {
             continue;
         }
-        let f = [p[(k + 1) % 4], p[(k + 2) % 4], p[(k + 3) % 4]];
-        let cand = triangle(f[0], f[1], f[2]);
-        if best.is_none_or(|(_, v)| cand.1.length_squared() < v.length_squared()) {
+        let cand = triangle(w, [(k + 1) % 4, (k + 2) % 4, (k + 3) % 4]);
+        if best.is_none_or(|b| cand.v.length_squared() < b.v.length_squared()) {
             best = Some(cand);
         }
     }
-    best.unwrap_or((Simplex::single(p[0]), w[0]))
+    best.unwrap_or(Sub::single(0, w[0]))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn sp(w: Vec3) -> SupportPoint {
-        SupportPoint {
-            w,
-            a: w,
-            b: Vec3::ZERO,
-        }
-    }
-
     #[test]
     fn segment_interior_and_ends() {
-        let (s, v) = segment(sp(Vec3::new(-1.0, 1.0, 0.0)), sp(Vec3::new(3.0, 1.0, 0.0)));
+        let two = |p: Vec3, q: Vec3| segment(&[p, q, Vec3::ZERO, Vec3::ZERO], 0, 1);
+        let s = two(Vec3::new(-1.0, 1.0, 0.0), Vec3::new(3.0, 1.0, 0.0));
         assert_eq!(s.len, 2);
-        assert!((v - Vec3::new(0.0, 1.0, 0.0)).length() < 1e-6);
-        let (s, v) = segment(sp(Vec3::new(1.0, 1.0, 0.0)), sp(Vec3::new(3.0, 1.0, 0.0)));
+        assert!((s.v - Vec3::new(0.0, 1.0, 0.0)).length() < 1e-6);
+        let s = two(Vec3::new(1.0, 1.0, 0.0), Vec3::new(3.0, 1.0, 0.0));
         assert_eq!(s.len, 1);
-        assert_eq!(v, Vec3::new(1.0, 1.0, 0.0));
+        assert_eq!(s.v, Vec3::new(1.0, 1.0, 0.0));
         // Degenerate: both points equal.
-        let (s, _) = segment(sp(Vec3::ONE), sp(Vec3::ONE));
-        assert_eq!(s.len, 1);
+        assert_eq!(two(Vec3::ONE, Vec3::ONE).len, 1);
     }
 
     #[test]
@@ -425,17 +460,18 @@ mod tests {
             Vec3::new(2.0, -1.0, 2.0),
             Vec3::new(-1.0, 2.0, 2.0),
         ];
-        let (s, v) = triangle(sp(t[0]), sp(t[1]), sp(t[2]));
+        let three = |a: Vec3, b: Vec3, c: Vec3| triangle(&[a, b, c, Vec3::ZERO], [0, 1, 2]);
+        let s = three(t[0], t[1], t[2]);
         assert_eq!(s.len, 3);
-        assert!((v - Vec3::new(0.0, 0.0, 2.0)).length() < 1e-6);
+        assert!((s.v - Vec3::new(0.0, 0.0, 2.0)).length() < 1e-6);
         // Shifted so the origin projects beyond the edge t0–t1.
         let off = Vec3::new(0.0, 3.0, 0.0);
-        let (s, v) = triangle(sp(t[0] + off), sp(t[1] + off), sp(t[2] + off));
+        let s = three(t[0] + off, t[1] + off, t[2] + off);
         assert_eq!(s.len, 2);
-        assert!((v - Vec3::new(0.0, 2.0, 2.0)).length() < 1e-6);
+        assert!((s.v - Vec3::new(0.0, 2.0, 2.0)).length() < 1e-6);
         // Collinear: no NaN, nearest vertex.
-        let (_, v) = triangle(sp(Vec3::X), sp(Vec3::X * 2.0), sp(Vec3::X * 3.0));
-        assert_eq!(v, Vec3::X);
+        let s = three(Vec3::X, Vec3::X * 2.0, Vec3::X * 3.0);
+        assert_eq!(s.v, Vec3::X);
     }
 
     #[test]
@@ -446,19 +482,18 @@ mod tests {
             Vec3::new(-1.0, -1.0, -1.0),
             Vec3::new(0.0, 0.0, 1.0),
         ];
-        let (s, v) = tetrahedron(t.map(sp));
+        let s = tetrahedron(&t);
         assert_eq!(s.len, 4);
-        assert_eq!(v, Vec3::ZERO);
+        assert_eq!(s.v, Vec3::ZERO);
         let sum: Real = s.lambda.iter().sum();
         assert!((sum - 1.0).abs() < 1e-6);
         let off = Vec3::new(0.0, 0.0, 2.0);
-        let (s, v) = tetrahedron(t.map(|p| sp(p + off)));
+        let s = tetrahedron(&t.map(|p| p + off));
         assert_eq!(s.len, 3);
-        assert!((v - Vec3::new(0.0, 0.0, 1.0)).length() < 1e-6);
+        assert!((s.v - Vec3::new(0.0, 0.0, 1.0)).length() < 1e-6);
         // Flat: no NaN.
-        let flat = [Vec3::X, Vec3::Y, -Vec3::X, -Vec3::Y].map(|p| sp(p + off));
-        let (_, v) = tetrahedron(flat);
-        assert!((v - off).length() < 1e-6);
+        let flat = [Vec3::X, Vec3::Y, -Vec3::X, -Vec3::Y].map(|p| p + off);
+        assert!((tetrahedron(&flat).v - off).length() < 1e-6);
     }
 
     #[test]

@@ -18,6 +18,7 @@ mod mesh;
 mod plane;
 mod sphere;
 
+pub(crate) use convex::within;
 pub use convex::{closest_points, ClosestPoints};
 pub use manifold::{
     feature_id, reduce, swap_feature, Candidate, ContactPoint, FeatureId, Manifold,

@@ -89,8 +89,13 @@ pub fn time_of_impact(
     let dv = sweep_a.translation - sweep_b.translation;
     let size = reach(a, Vec3::ZERO) + reach(b, Vec3::ZERO);
     let mut t: Real = 0.0;
+    // A sweep that neither moves nor turns (a static body's) has one pose for every t.
+    let fixed =
+        |s: &Sweep| (s.translation == Vec3::ZERO && s.rotation == Vec3::ZERO).then(|| s.at(0.0));
+    let (fixed_a, fixed_b) = (fixed(sweep_a), fixed(sweep_b));
     for iteration in 0..=MAX_ITERATIONS {
-        let (pa, pb) = (sweep_a.at(t), sweep_b.at(t));
+        let pa = fixed_a.unwrap_or_else(|| sweep_a.at(t));
+        let pb = fixed_b.unwrap_or_else(|| sweep_b.at(t));
         let c = closest_points(a, &pa, b, &pb);
         // Rounding in the distance grows with the coordinates of the pair as it stands.
         let scale = size + (pa.position - pb.position).length();
