@@ -18,7 +18,9 @@
 
 mod body;
 mod contact;
+mod contact_wide;
 mod joint;
+mod lanes;
 mod restitution;
 mod softness;
 
@@ -171,9 +173,7 @@ impl Solver {
             for j in &mut self.joints {
                 j.warm_start(&self.sims, &mut self.states);
             }
-            for c in &self.constraints {
-                c.warm_start(&self.points.hot, &mut self.states);
-            }
+            contact_wide::warm_start(&self.constraints, &self.points, &mut self.states);
             // The substep's impulses are final once the last pass has visited a
             // manifold, so that pass adds them to the step's totals on its way instead
             // of a separate walk over every point.
@@ -266,6 +266,7 @@ impl Solver {
                 &mut self.points,
             ));
         }
+        self.points.group_lanes(&self.constraints);
     }
 
     /// Chooses each body's kick. Bodies in contact take symplectic Euler's whole kick
@@ -332,24 +333,11 @@ impl Solver {
         coloured
     }
 
-    /// One pass over every constraint, in colour order; neighbours of one colour are
-    /// solved two at a time (see `ContactConstraint::solve_two`).
+    /// One pass over every constraint, in colour order; consecutive constraints of one
+    /// colour are solved several at a time in lanes (see `contact_wide`).
     fn solve_pass(&mut self, rule: &BiasRule, bias: bool, totals: bool) {
-        let cs = &self.constraints;
-        let mut i = 0;
-        while i < cs.len() {
-            match cs.get(i + 1).filter(|next| cs[i].pairs_with(next)) {
-                Some(next) => {
-                    let pass = (rule, bias, totals);
-                    cs[i].solve_two(next, &mut self.points, &mut self.states, pass);
-                    i += 2;
-                }
-                None => {
-                    cs[i].solve(&mut self.points, &mut self.states, rule, bias, totals);
-                    i += 1;
-                }
-            }
-        }
+        let pass = contact_wide::Pass { rule, bias, totals };
+        contact_wide::solve_pass(&self.constraints, &mut self.points, &mut self.states, pass);
     }
 
     /// v += h F/m, L += h N, over the substep's start (`end` false) or end: bodies in
