@@ -22,7 +22,6 @@
 use super::body::BodyState;
 use super::contact::{BiasRule, ContactConstraint, Point, PointCold, Points, Row};
 use super::lanes::{Lanes, Lanes3, Mask, LANES};
-use crate::math::Real;
 
 /// Fewest constraints worth a group: a single one is solved faster by the scalar code.
 const MIN_LANES: usize = 2;
@@ -74,8 +73,8 @@ struct Group {
     a: [usize; LANES],
     b: [usize; LANES],
     /// Bit l: lane l's body a (b) moves; never set for unused lanes.
-    moves_a: u8,
-    moves_b: u8,
+    moves_a: u32,
+    moves_b: u32,
     normal: Lanes3,
     tangents: [Lanes3; 2],
     /// M⁻¹ d of each body for d = n, t₁, t₂.
@@ -165,54 +164,41 @@ impl ContactLanes {
         hot: &[Point],
         cold: &[PointCold],
     ) {
+        // Unused lanes repeat lane 0's constraint, which they only read; missing points
+        // stay zeros, and their lanes are masked out.
         let lane = |l: usize| &cs[if l < cs.len() { l } else { 0 }];
-        let bits = |f: &dyn Fn(&ContactConstraint) -> bool| {
-            (0..cs.len()).fold(0u8, |m, l| m | (u8::from(f(&cs[l])) << l))
-        };
         let vec =
             |f: &dyn Fn(&ContactConstraint) -> crate::math::Vec3| Lanes3::from_fn(|l| f(lane(l)));
+        let moves = |side: usize| {
+            let moving = cs.iter().map(|c| [c.moves().0, c.moves().1][side]);
+            moving
+                .enumerate()
+                .fold(0u32, |m, (l, on)| m | (u32::from(on) << l))
+        };
+        let slot0 = self.slots.len();
         let slots = cs.iter().map(|c| c.range().len()).max().unwrap_or(0);
         let group = Group {
             first,
             lanes: cs.len(),
             a: std::array::from_fn(|l| lane(l).bodies().0),
             b: std::array::from_fn(|l| lane(l).bodies().1),
-            moves_a: bits(&|c| c.moves().0),
-            moves_b: bits(&|c| c.moves().1),
+            moves_a: moves(0),
+            moves_b: moves(1),
             normal: vec(&|c| c.normal()),
             tangents: [vec(&|c| c.tangents()[0]), vec(&|c| c.tangents()[1])],
             push_a: std::array::from_fn(|k| vec(&|c| c.pushes().0[k])),
             push_b: std::array::from_fn(|k| vec(&|c| c.pushes().1[k])),
             friction: Lanes::from_fn(|l| lane(l).friction()),
-            slot0: self.slots.len(),
+            slot0,
             slots,
         };
-        for j in 0..slots {
-            // Missing points read as zeros; their lanes are masked out.
-            let point = |l: usize| {
-                let c = cs.get(l).filter(|c| j < c.range().len());
-                c.map(|c| (hot[c.range().start + j], cold[c.range().start + j]))
-            };
-            let pts: [_; LANES] = std::array::from_fn(point);
-            let active = Mask::from_fn(|l| pts[l].is_some());
-            let moves = |m: u8| Mask::from_fn(|l| m & (1 << l) != 0);
-            let (p, c): ([Point; LANES], [PointCold; LANES]) = (
-                std::array::from_fn(|l| pts[l].map(|x| x.0).unwrap_or_default()),
-                std::array::from_fn(|l| pts[l].map(|x| x.1).unwrap_or_default()),
-            );
-            self.slots.push(Slot::new(
-                &p,
-                (
-                    active,
-                    active & moves(group.moves_a),
-                    active & moves(group.moves_b),
-                ),
-            ));
-            self.cold.push(SlotCold {
-                approach_velocity: Lanes::from_fn(|l| c[l].approach_velocity),
-                total_normal: Lanes::from_fn(|l| c[l].total_normal),
-                total_tangent: std::array::from_fn(|k| Lanes::from_fn(|l| c[l].total_tangent[k])),
-            });
+        self.slots.resize(slot0 + slots, Slot::default());
+        self.cold.resize(slot0 + slots, SlotCold::default());
+        for (l, c) in cs.iter().enumerate() {
+            for (j, i) in c.range().enumerate() {
+                self.slots[slot0 + j].set_lane(l, &hot[i], c.moves());
+                self.cold[slot0 + j].set_lane(l, &cold[i]);
+            }
         }
         self.groups.push(group);
     }
@@ -229,10 +215,10 @@ impl ContactLanes {
             return;
         }
         for g in &self.groups {
-            for (l, c) in constraints[g.first..g.first + g.lanes].iter().enumerate() {
-                let points = c.range();
-                let slots = self.slots[g.slot0..].iter().zip(&self.cold[g.slot0..]);
-                for (i, (s, sc)) in points.zip(slots) {
+            let lanes = constraints[g.first..g.first + g.lanes].iter().enumerate();
+            for (l, c) in lanes {
+                for (j, i) in c.range().enumerate() {
+                    let (s, sc) = (&self.slots[g.slot0 + j], &self.cold[g.slot0 + j]);
                     let (p, pc) = (&mut hot[i], &mut cold[i]);
                     p.normal_impulse = s.normal_impulse.0[l];
                     p.tangent_impulse = [s.tangent_impulse[0].0[l], s.tangent_impulse[1].0[l]];
@@ -247,12 +233,10 @@ impl ContactLanes {
 }
 
 impl RowLanes {
-    fn new(rows: [&Row; LANES]) -> RowLanes {
-        RowLanes {
-            turn_a: Lanes3::from_fn(|l| rows[l].turn_a),
-            turn_b: Lanes3::from_fn(|l| rows[l].turn_b),
-            mass: Lanes::from_fn(|l| rows[l].mass),
-        }
+    fn set_lane(&mut self, l: usize, row: &Row) {
+        self.turn_a.set_lane(l, row.turn_a);
+        self.turn_b.set_lane(l, row.turn_b);
+        self.mass.0[l] = row.mass;
     }
 
     /// `Row::velocity` per lane.
@@ -272,29 +256,35 @@ impl RowLanes {
 }
 
 impl Slot {
-    fn new(p: &[Point; LANES], (active, apply_a, apply_b): (Mask, Mask, Mask)) -> Slot {
-        let each = |f: fn(&Point) -> Real| Lanes::from_fn(|l| f(&p[l]));
-        Slot {
-            ra: Lanes3::from_fn(|l| p[l].ra),
-            rb: Lanes3::from_fn(|l| p[l].rb),
-            separation: each(|p| p.separation),
-            lever: each(|p| p.lever),
-            normal: RowLanes::new(std::array::from_fn(|l| &p[l].normal)),
-            tangent: std::array::from_fn(|k| {
-                RowLanes::new(std::array::from_fn(|l| &p[l].tangent[k]))
-            }),
-            normal_impulse: each(|p| p.normal_impulse),
-            tangent_impulse: [
-                each(|p| p.tangent_impulse[0]),
-                each(|p| p.tangent_impulse[1]),
-            ],
-            max_normal_impulse: each(|p| p.max_normal_impulse),
-            anchor_gap: [each(|p| p.anchor_gap[0]), each(|p| p.anchor_gap[1])],
-            tangent_lever: [each(|p| p.tangent_lever[0]), each(|p| p.tangent_lever[1])],
-            active,
-            apply_a,
-            apply_b,
-        }
+    /// Makes lane `l` point `p`, of a manifold whose bodies move as `moves` says.
+    fn set_lane(&mut self, l: usize, p: &Point, moves: (bool, bool)) {
+        self.ra.set_lane(l, p.ra);
+        self.rb.set_lane(l, p.rb);
+        self.separation.0[l] = p.separation;
+        self.lever.0[l] = p.lever;
+        self.normal.set_lane(l, &p.normal);
+        self.tangent[0].set_lane(l, &p.tangent[0]);
+        self.tangent[1].set_lane(l, &p.tangent[1]);
+        self.normal_impulse.0[l] = p.normal_impulse;
+        self.tangent_impulse[0].0[l] = p.tangent_impulse[0];
+        self.tangent_impulse[1].0[l] = p.tangent_impulse[1];
+        self.max_normal_impulse.0[l] = p.max_normal_impulse;
+        self.anchor_gap[0].0[l] = p.anchor_gap[0];
+        self.anchor_gap[1].0[l] = p.anchor_gap[1];
+        self.tangent_lever[0].0[l] = p.tangent_lever[0];
+        self.tangent_lever[1].0[l] = p.tangent_lever[1];
+        self.active.set(l, true);
+        self.apply_a.set(l, moves.0);
+        self.apply_b.set(l, moves.1);
+    }
+}
+
+impl SlotCold {
+    fn set_lane(&mut self, l: usize, c: &PointCold) {
+        self.approach_velocity.0[l] = c.approach_velocity;
+        self.total_normal.0[l] = c.total_normal;
+        self.total_tangent[0].0[l] = c.total_tangent[0];
+        self.total_tangent[1].0[l] = c.total_tangent[1];
     }
 }
 
