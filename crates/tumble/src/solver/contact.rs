@@ -12,6 +12,10 @@
 //! and the same with the two tangents t₁, t₂ for friction. Everything that does not change
 //! within a step (the r × d terms, their images under I⁻¹, the effective masses) is
 //! computed once in `prepare`; a pass then costs a few dot products per row.
+//!
+//! The solve, relax and warm-start passes run most manifolds eight at a time in lanes
+//! (`super::contact_wide`), bit for bit as the scalar code here runs them one by one;
+//! this scalar code serves the rest, the end-of-step bounces and the reports.
 
 use super::body::{BodySim, BodyState};
 use super::contact_wide::ContactLanes;
