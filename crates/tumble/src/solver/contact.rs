@@ -12,8 +12,13 @@
 //! and the same with the two tangents t₁, t₂ for friction. Everything that does not change
 //! within a step (the r × d terms, their images under I⁻¹, the effective masses) is
 //! computed once in `prepare`; a pass then costs a few dot products per row.
+//!
+//! The solve, relax and warm-start passes run most manifolds eight at a time in lanes
+//! (`super::contact_wide`), bit for bit as the scalar code here runs them one by one;
+//! this scalar code serves the rest, the end-of-step bounces and the reports.
 
 use super::body::{BodySim, BodyState};
+use super::contact_wide::ContactLanes;
 use super::softness::Softness;
 use crate::contact_cache::Contact;
 use crate::geometry::Pose;
@@ -44,11 +49,11 @@ pub(crate) struct BiasRule {
 /// effective mass. The angular parts r × d themselves are recomputed where needed: two
 /// cross products cost less than streaming 48 more bytes per row through every pass.
 #[derive(Debug, Clone, Copy, Default)]
-struct Row {
+pub(super) struct Row {
     /// I_a⁻¹ (r_a × d) and I_b⁻¹ (r_b × d): the change of ω per unit impulse.
-    turn_a: Vec3,
-    turn_b: Vec3,
-    mass: Real,
+    pub turn_a: Vec3,
+    pub turn_b: Vec3,
+    pub mass: Real,
 }
 
 impl Row {
@@ -111,24 +116,24 @@ impl Row {
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Point {
     /// Anchors from each centre of mass, world frame, at the start of the step.
-    ra: Vec3,
-    rb: Vec3,
+    pub(super) ra: Vec3,
+    pub(super) rb: Vec3,
     /// Separation at the start of the step.
-    separation: Real,
+    pub(super) separation: Real,
     /// n · (r_b − r_a): with the bodies' motion since the step began it gives the current
     /// separation without rotating the anchors (see `solve`).
-    lever: Real,
-    normal: Row,
-    tangent: [Row; 2],
-    normal_impulse: Real,
-    tangent_impulse: [Real; 2],
+    pub(super) lever: Real,
+    pub(super) normal: Row,
+    pub(super) tangent: [Row; 2],
+    pub(super) normal_impulse: Real,
+    pub(super) tangent_impulse: [Real; 2],
     /// Largest normal impulse of the step: restitution only acts where contact pushed.
-    max_normal_impulse: Real,
+    pub(super) max_normal_impulse: Real,
     /// Friction anchors: how far apart, along each tangent, the two material points that
     /// touched when the contact began were at the step's start (zero for a new point).
-    anchor_gap: [Real; 2],
+    pub(super) anchor_gap: [Real; 2],
     /// t · (r_b − r_a) per tangent, for the anchors' current gap (as `lever` for the normal).
-    tangent_lever: [Real; 2],
+    pub(super) tangent_lever: [Real; 2],
 }
 
 /// A contact point's data that the solve passes seldom touch: bounces and reports.
@@ -136,7 +141,7 @@ pub(crate) struct Point {
 pub(crate) struct PointCold {
     /// Normal velocity before the step, lowered to the velocity at the moment of impact
     /// if the step's gravity sped the approach up: the speed restitution reflects.
-    approach_velocity: Real,
+    pub(super) approach_velocity: Real,
     /// Normal velocity before the step, as it was.
     start_velocity: Real,
     /// The bounce pass's replay of the step's impacts (see `super::restitution`): the
@@ -149,21 +154,37 @@ pub(crate) struct PointCold {
     /// Impulse the bounce pass added (or took back) at the end of the step.
     bounce_impulse: Real,
     /// Impulses summed over the step's substeps (for reporting).
-    total_normal: Real,
-    total_tangent: [Real; 2],
+    pub(super) total_normal: Real,
+    pub(super) total_tangent: [Real; 2],
 }
 
-/// Every contact point of the step, manifold by manifold, hot and cold parts in step.
+/// Every contact point of the step, manifold by manifold, hot and cold parts in step;
+/// `lanes` holds the wide passes' copy of the grouped manifolds' points, whose impulses
+/// are the current ones until [`Points::save_lanes`] copies them back.
 #[derive(Debug, Default)]
 pub(crate) struct Points {
     pub hot: Vec<Point>,
     pub cold: Vec<PointCold>,
+    pub lanes: ContactLanes,
 }
 
 impl Points {
     pub fn clear(&mut self) {
         self.hot.clear();
         self.cold.clear();
+        self.lanes.clear();
+    }
+
+    /// Groups the constraints (in the solver's order) for the wide passes; no group
+    /// spans `split`, where the passes of the heavy islands start.
+    pub fn group_lanes(&mut self, constraints: &[ContactConstraint], split: usize) {
+        self.lanes.build(constraints, split, &self.hot, &self.cold);
+    }
+
+    /// Brings the grouped points' impulses and totals back from the lanes.
+    pub fn save_lanes(&mut self, constraints: &[ContactConstraint]) {
+        self.lanes
+            .write_back(constraints, &mut self.hot, &mut self.cold);
     }
 }
 
@@ -226,7 +247,7 @@ fn friction_impulse(want: [Real; 2], vt: [Real; 2], limit: Real, slip_speed: Rea
 /// 20-box tower swayed 6.5 cm (the tangential springs feed its tilt); at half it stands
 /// within millimetres and the 385-box pyramid still holds to 0.05 mm over 10 s (2 mm
 /// without anchors).
-const ANCHOR_STIFFNESS: Real = 0.5;
+pub(super) const ANCHOR_STIFFNESS: Real = 0.5;
 
 /// Passes over a manifold's points when the bounce replay resolves one collision.
 const REPLAY_ITERATIONS: usize = 4;
@@ -316,8 +337,36 @@ impl ContactConstraint {
         (self.a, self.b)
     }
 
-    fn range(&self) -> std::ops::Range<usize> {
+    /// The manifold's points' indices in [`Points`].
+    pub fn range(&self) -> std::ops::Range<usize> {
         self.first..self.first + self.count
+    }
+
+    /// Graph colour (see `Solver::colour_order`).
+    pub fn colour(&self) -> u32 {
+        self.colour
+    }
+
+    /// Whether the solver moves body a, body b.
+    pub fn moves(&self) -> (bool, bool) {
+        self.moves
+    }
+
+    pub fn normal(&self) -> Vec3 {
+        self.normal
+    }
+
+    pub fn tangents(&self) -> [Vec3; 2] {
+        self.tangents
+    }
+
+    /// M⁻¹ d of each body for d = n, t₁, t₂.
+    pub fn pushes(&self) -> ([Vec3; 3], [Vec3; 3]) {
+        (self.push_a, self.push_b)
+    }
+
+    pub fn friction(&self) -> Real {
+        self.friction
     }
 
     /// Applies the accumulated impulses again (each substep, as Box2D v3 does).
@@ -387,73 +436,6 @@ impl ContactConstraint {
         }
         if totals {
             ContactConstraint::add_to_totals(hot, &mut points.cold[self.range()]);
-        }
-    }
-
-    /// Whether `self` and the next constraint `next` may be solved together: same colour,
-    /// so no moving body in common (colour 63 collects the overflow and guarantees nothing),
-    /// and no static one either (the borrows must be disjoint).
-    pub fn pairs_with(&self, next: &ContactConstraint) -> bool {
-        self.colour == next.colour
-            && self.colour < 63
-            && next.first == self.first + self.count
-            && ![self.a, self.b].contains(&next.a)
-            && ![self.a, self.b].contains(&next.b)
-    }
-
-    /// [`Self::solve`] for `self` and `next` (see [`Self::pairs_with`]), point by point in
-    /// turn. A pass is a chain of dependent updates through each manifold's two bodies;
-    /// two chains on disjoint bodies let the processor work on both at once. Every update
-    /// is the one the two separate passes would make, so results are bit-identical.
-    pub fn solve_two(
-        &self,
-        next: &ContactConstraint,
-        points: &mut Points,
-        states: &mut [BodyState],
-        (rule, bias, totals): (&BiasRule, bool, bool),
-    ) {
-        let Ok([a1, b1, a2, b2]) = states.get_disjoint_mut([self.a, self.b, next.a, next.b]) else {
-            self.solve(points, states, rule, bias, totals);
-            next.solve(points, states, rule, bias, totals);
-            return;
-        };
-        let span = self.first..next.first + next.count;
-        let (h1, h2) = points.hot[span.clone()].split_at_mut(self.count);
-        let cold = &mut points.cold[span];
-        let (m1, m2) = (self.moved(a1, b1), next.moved(a2, b2));
-        let order = |c: &ContactConstraint, k: usize| if bias { k } else { c.count - 1 - k };
-        for k in 0..self.count.max(next.count) {
-            if k < self.count {
-                let i = order(self, k);
-                if let Some(vn) = self.solve_normal(&mut h1[i], a1, b1, rule, bias, m1) {
-                    let c = &mut cold[i];
-                    c.approach_velocity = c.approach_velocity.min(vn);
-                }
-            }
-            if k < next.count {
-                let i = order(next, k);
-                if let Some(vn) = next.solve_normal(&mut h2[i], a2, b2, rule, bias, m2) {
-                    let c = &mut cold[self.count + i];
-                    c.approach_velocity = c.approach_velocity.min(vn);
-                }
-            }
-        }
-        let (s1, s2) = (
-            bias.then(|| self.slip(a1, b1)),
-            bias.then(|| next.slip(a2, b2)),
-        );
-        for k in 0..self.count.max(next.count) {
-            if k < self.count {
-                self.solve_friction(&mut h1[order(self, k)], a1, b1, rule, s1);
-            }
-            if k < next.count {
-                next.solve_friction(&mut h2[order(next, k)], a2, b2, rule, s2);
-            }
-        }
-        if totals {
-            let (c1, c2) = cold.split_at_mut(self.count);
-            ContactConstraint::add_to_totals(h1, c1);
-            ContactConstraint::add_to_totals(h2, c2);
         }
     }
 

@@ -18,7 +18,9 @@
 
 mod body;
 mod contact;
+mod contact_wide;
 mod joint;
+mod lanes;
 mod mass_ratio;
 mod restitution;
 mod softness;
@@ -181,9 +183,7 @@ impl Solver {
             for j in &mut self.joints {
                 j.warm_start(&self.sims, &mut self.states);
             }
-            for c in &self.constraints {
-                c.warm_start(&self.points.hot, &mut self.states);
-            }
+            contact_wide::warm_start(&self.constraints, &self.points, &mut self.states);
             let iterations = input.settings.iterations;
             let relax = input.settings.kind == SolverKind::SoftStep && iterations > 0;
             self.passes(iterations, (&rule, &solve_pass), true, !relax);
@@ -325,6 +325,8 @@ impl Solver {
                 &mut self.points,
             ));
         }
+        self.points
+            .group_lanes(&self.constraints, self.heavy_contacts);
     }
 
     /// Chooses each body's kick. Bodies in contact take symplectic Euler's whole kick
@@ -381,6 +383,7 @@ impl Solver {
     /// dependent updates; constraints on disjoint bodies let the processor overlap them.
     /// Deterministic: colours depend only on the contacts' order, itself deterministic.
     /// Contacts of islands with a large mass ratio come last, for their extra passes.
+    /// Colour 63 keeps the contacts' order.
     fn colour_order(&self, contacts: &[Contact], ghosts: &[bool]) -> Vec<(bool, u32, usize)> {
         let mut used = vec![0u64; self.sims.len()];
         let mut coloured = Vec::with_capacity(contacts.len());
@@ -398,28 +401,23 @@ impl Solver {
             }
             coloured.push((self.is_heavy(a) || self.is_heavy(b), colour, i));
         }
-        coloured.sort_unstable();
+        // Within a colour below 63 the order is free (no moving body in common, so the
+        // updates commute, bit for bit): manifolds of equal size go together, so that the
+        // lane groups (see `contact_wide`) carry few empty points.
+        let size = |colour: u32, i: usize| match colour {
+            63 => 0,
+            _ => contacts[i].manifold.len(),
+        };
+        coloured.sort_unstable_by_key(|&(heavy, colour, i)| (heavy, colour, size(colour, i), i));
         coloured
     }
 
-    /// One pass over every constraint, in colour order; neighbours of one colour are
-    /// solved two at a time (see `ContactConstraint::solve_two`).
+    /// One pass over the constraints in `range`, in colour order; consecutive constraints
+    /// of one colour are solved several at a time in lanes (see `contact_wide`).
     fn solve_pass(&mut self, range: Range<usize>, rule: &BiasRule, bias: bool, totals: bool) {
-        let cs = &self.constraints[..range.end];
-        let mut i = range.start;
-        while i < cs.len() {
-            match cs.get(i + 1).filter(|next| cs[i].pairs_with(next)) {
-                Some(next) => {
-                    let pass = (rule, bias, totals);
-                    cs[i].solve_two(next, &mut self.points, &mut self.states, pass);
-                    i += 2;
-                }
-                None => {
-                    cs[i].solve(&mut self.points, &mut self.states, rule, bias, totals);
-                    i += 1;
-                }
-            }
-        }
+        let pass = contact_wide::Pass { rule, bias, totals };
+        let (cs, points, states) = (&self.constraints, &mut self.points, &mut self.states);
+        contact_wide::solve_pass(cs, range, points, states, pass);
     }
 
     /// v += h F/m, L += h N, over the substep's start (`end` false) or end: bodies in

@@ -31,6 +31,9 @@ pub(crate) fn resolve_bounces(
     moves: &[bool],
     threshold: Real,
 ) {
+    // The wide passes' impulses go back to the points first; this pass and the contacts'
+    // impulses read them there.
+    points.save_lanes(constraints);
     let cluster = bounce_cluster(constraints, points, moves, threshold);
     if cluster.is_empty() {
         return;
