@@ -147,7 +147,8 @@ pub(crate) fn update_sleep(
     *tag = first_tag.wrapping_add(bodies.len() as u32);
 }
 
-fn find(parent: &mut [usize], mut i: usize) -> usize {
+/// The root of `i`'s set in the union–find forest `parent` (path halving).
+pub(crate) fn find(parent: &mut [usize], mut i: usize) -> usize {
     while parent[i] != i {
         parent[i] = parent[parent[i]];
         i = parent[i];
@@ -155,7 +156,8 @@ fn find(parent: &mut [usize], mut i: usize) -> usize {
     i
 }
 
-fn union(parent: &mut [usize], a: usize, b: usize) {
+/// Joins the sets of `a` and `b` in `parent`.
+pub(crate) fn union(parent: &mut [usize], a: usize, b: usize) {
     let (ra, rb) = (find(parent, a), find(parent, b));
     // The smaller index becomes the root so islands are numbered the same every run.
     if ra < rb {

@@ -731,15 +731,14 @@ pub struct ClosestPoints {
 /// subtracted; overlapping cores go to the separating-axis test (polytope cores) or EPA
 /// (cylinders). Never NaN: non-finite poses give an infinite distance.
 pub fn closest_points(a: &Convex, pa: &Pose, b: &Convex, pb: &Pose) -> ClosestPoints {
-    let pair = Pair::new(a, pa, b, pb);
-    if !pair.is_finite() || !pa.position.is_finite() || !pa.rotation.is_finite() {
+    let Some(pair) = finite_pair(a, pa, b, pb) else {
         return ClosestPoints {
             distance: Real::INFINITY,
             normal: Vec3::X,
             point_a: Vec3::ZERO,
             point_b: Vec3::ZERO,
         };
-    }
+    };
     // The cores as polytopes (two heap lists each) serve only overlapping cores; apart,
     // the usual case (every step of a time-of-impact search), GJK's answer is final.
     let g = gjk(&pair, Real::INFINITY);
@@ -772,10 +771,9 @@ pub fn closest_points(a: &Convex, pa: &Pose, b: &Convex, pb: &Pose) -> ClosestPo
 /// `closest_points` runs for them, with its polytopes, was most of the cost of asking this
 /// about bodies that end a sweep interpenetrating).
 pub(crate) fn within(a: &Convex, pa: &Pose, b: &Convex, pb: &Pose, limit: Real) -> bool {
-    let pair = Pair::new(a, pa, b, pb);
-    if !pair.is_finite() || !pa.position.is_finite() || !pa.rotation.is_finite() {
+    let Some(pair) = finite_pair(a, pa, b, pb) else {
         return false;
-    }
+    };
     let rounding = a.radius() + b.radius();
     let g = gjk(&pair, limit + rounding);
     match g.status {
@@ -783,6 +781,12 @@ pub(crate) fn within(a: &Convex, pa: &Pose, b: &Convex, pb: &Pose, limit: Real) 
         Status::Overlap => true,
         Status::Separated => g.distance() - rounding <= limit,
     }
+}
+
+/// The pair in A's frame, or `None` when a pose is not finite (no distance to find).
+fn finite_pair<'a>(a: &'a Convex, pa: &Pose, b: &'a Convex, pb: &Pose) -> Option<Pair<'a>> {
+    let pair = Pair::new(a, pa, b, pb);
+    (pair.is_finite() && pa.position.is_finite() && pa.rotation.is_finite()).then_some(pair)
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@
 //! the islands that need it keeps every other scene's cost and results as they were.
 
 use super::body::BodySim;
+use crate::island::{find, union};
 use crate::math::Real;
 
 /// Mass ratio across a contact or joint, between two bodies the solver moves, from which
@@ -43,45 +44,19 @@ pub(crate) fn heavy_islands(
         return None;
     }
     let passes = if largest >= VERY_HEAVY_RATIO { 3 } else { 2 };
-    let mut sets = DisjointSets::new(sims.len());
+    let mut parent: Vec<usize> = (0..sims.len()).collect();
     for (a, b) in links.clone() {
         if moving(a) && moving(b) {
-            sets.join(a, b);
+            union(&mut parent, a, b);
         }
     }
     let mut heavy_root = vec![false; sims.len()];
     for (a, _) in links.filter(|&l| heavy_pair(l)) {
-        let root = sets.root(a);
+        let root = find(&mut parent, a);
         heavy_root[root] = true;
     }
-    let flags = (0..sims.len()).map(|k| heavy_root[sets.root(k)]).collect();
+    let flags = (0..sims.len())
+        .map(|k| heavy_root[find(&mut parent, k)])
+        .collect();
     Some((flags, passes))
-}
-
-/// Union–find with path halving; joins by index so that roots are deterministic.
-struct DisjointSets {
-    parent: Vec<usize>,
-}
-
-impl DisjointSets {
-    fn new(n: usize) -> Self {
-        DisjointSets {
-            parent: (0..n).collect(),
-        }
-    }
-
-    fn root(&mut self, mut k: usize) -> usize {
-        while self.parent[k] != k {
-            self.parent[k] = self.parent[self.parent[k]];
-            k = self.parent[k];
-        }
-        k
-    }
-
-    fn join(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.root(a), self.root(b));
-        if ra != rb {
-            self.parent[ra.max(rb)] = ra.min(rb);
-        }
-    }
 }

@@ -292,11 +292,6 @@ impl Solver {
             mass_ratio::heavy_islands(&self.sims, touching.chain(joined)).unwrap_or_default();
     }
 
-    /// Whether body `k` is in an island with a large mass ratio.
-    fn is_heavy(&self, k: usize) -> bool {
-        self.heavy.get(k).copied().unwrap_or(false)
-    }
-
     fn prepare(&mut self, contacts: &[Contact], ghosts: &[bool]) {
         self.constraints.clear();
         self.points.clear();
@@ -368,10 +363,8 @@ impl Solver {
         // Joints of islands with a large mass ratio go last, in creation order, for their
         // extra passes (see `passes`); the others keep their order.
         let flags = &self.heavy;
-        let heavy = |c: &JointConstraint| {
-            let heavy = |k: usize| flags.get(k).copied().unwrap_or(false);
-            c.bodies().into_iter().flatten().any(heavy)
-        };
+        let heavy =
+            |c: &JointConstraint| c.bodies().into_iter().flatten().any(|k| is_heavy(flags, k));
         let (mut light, heavy): (Vec<_>, Vec<_>) = self.joints.drain(..).partition(|c| !heavy(c));
         self.heavy_joints = light.len();
         light.extend(heavy);
@@ -399,7 +392,8 @@ impl Solver {
                     used[k] |= 1u64 << colour;
                 }
             }
-            coloured.push((self.is_heavy(a) || self.is_heavy(b), colour, i));
+            let heavy = is_heavy(&self.heavy, a) || is_heavy(&self.heavy, b);
+            coloured.push((heavy, colour, i));
         }
         // Within a colour below 63 the order is free (no moving body in common, so the
         // updates commute, bit for bit): manifolds of equal size go together, so that the
@@ -486,6 +480,12 @@ impl Solver {
             state.dr = Mat3::from_quat(sim.q * sim.q0.inverse());
         }
     }
+}
+
+/// Whether body `k` is in an island with a large mass ratio, by the solver's `heavy` flags
+/// (empty when no island has one).
+fn is_heavy(heavy: &[bool], k: usize) -> bool {
+    heavy.get(k).copied().unwrap_or(false)
 }
 
 /// Whether contact `i` sits the step out: no points, or a speculative ghost.
