@@ -210,7 +210,7 @@ impl Body {
             angular_momentum: Vec3::ZERO,
             angular_velocity: def.angular_velocity,
         };
-        body.ccd_extent = crate::ccd::ccd_extent(&body.shape);
+        body.ccd_extent = ccd_extent(&body.shape);
         let r = Mat3::from_quat(orientation);
         body.planar_inertia = (r * props.inertia * r.transpose()).z_axis.z;
         if body.planar {
@@ -488,4 +488,46 @@ pub(crate) fn validate_inertia(spec: InertiaSpec) -> Result<Mat3> {
         ));
     }
     Ok(m)
+}
+
+/// One body's dynamic state at some time (a step's start, or an integrator's stage).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Motion {
+    /// Centre of mass (m).
+    pub x: Vec3,
+    /// Orientation.
+    pub q: Quat,
+    /// Velocity of the centre of mass (m/s).
+    pub v: Vec3,
+    /// Angular momentum about the centre of mass (kg·m²/s).
+    pub l: Vec3,
+    /// Angular velocity (rad/s): derived from `l` for dynamic bodies.
+    pub w: Vec3,
+}
+
+impl Motion {
+    pub(crate) fn of(body: &Body) -> Motion {
+        Motion {
+            x: body.com,
+            q: body.orientation,
+            v: body.velocity,
+            l: body.angular_momentum,
+            w: body.angular_velocity,
+        }
+    }
+}
+
+/// The thickness below which a step's travel counts as fast: half the smallest extent of
+/// the shape's bounding box, or of its thinnest compound child.
+fn ccd_extent(shape: &Shape) -> Real {
+    match shape {
+        Shape::Compound(children) => children
+            .iter()
+            .map(|c| ccd_extent(&c.shape))
+            .fold(Real::INFINITY, Real::min),
+        _ => shape
+            .aabb(&crate::geometry::Pose::IDENTITY)
+            .half_extents()
+            .min_element(),
+    }
 }

@@ -9,98 +9,103 @@
 use crate::body::{Body, BodyKind};
 use crate::broad_phase::BroadPhase;
 use crate::geometry::{Convex, Pose};
-use crate::integrate::Motion;
 use crate::math::{quat_from_rotation_vector, Quat, Real, Vec3};
 use crate::query::{time_of_impact, Sweep};
 use crate::shape::Shape;
+use crate::solver::{BodySim, SolverBodies};
 
-/// The thickness below which a step's travel counts as fast: half the smallest extent of
-/// the shape's bounding box, or of its thinnest compound child.
-pub(crate) fn ccd_extent(shape: &Shape) -> Real {
-    match shape {
-        Shape::Compound(children) => children
-            .iter()
-            .map(|c| ccd_extent(&c.shape))
-            .fold(Real::INFINITY, Real::min),
-        _ => shape.aabb(&Pose::IDENTITY).half_extents().min_element(),
-    }
-}
-
-/// A body's motion over the step as a sweep of its frame.
-fn sweep_of(body: &Body, start: &Motion, end: &Motion) -> Sweep {
-    let origin = start.x - start.q * body.local_center;
+/// A body's motion over the step, from its pose at the step's start (`x0`, `q0`) to its
+/// pose now, as a sweep of its frame.
+fn sweep_of(body: &Body, s: &BodySim) -> Sweep {
+    let origin = s.x0 - s.q0 * body.local_center;
     Sweep {
-        start: Pose::new(origin, start.q),
-        translation: end.x - start.x,
-        rotation: (end.q * start.q.inverse()).to_scaled_axis(),
+        start: Pose::new(origin, s.q0),
+        translation: s.x - s.x0,
+        rotation: (s.q * s.q0.inverse()).to_scaled_axis(),
         local_center: body.local_center,
     }
 }
 
-/// Moves fast bodies of `motions` back to their first time of impact.
+/// Whether body `i` moved farther this step than its own thickness (or is a bullet).
+fn is_fast(b: &Body, s: &BodySim) -> bool {
+    b.kind == BodyKind::Dynamic && b.awake && (b.bullet || (s.x - s.x0).length() > b.ccd_extent)
+}
+
+/// Stage of the step: moves fast bodies back to their first time of impact over the
+/// step. Reads the bodies' shapes and poses at the step's start (`bodies`, the broad
+/// phase, each solver body's `x0`, `q0`) and their poses now; writes the pose and ω of
+/// the bodies it moves back.
 pub(crate) fn sweep_fast_bodies(
     bodies: &[Body],
-    start: &[Motion],
-    motions: &mut [Motion],
+    solver_bodies: &mut SolverBodies,
     broad: &BroadPhase,
     slop: Real,
 ) {
+    let sims = &solver_bodies.sims;
     let fast: Vec<bool> = bodies
         .iter()
-        .zip(start.iter().zip(motions.iter()))
-        .map(|(b, (s, m))| {
-            b.kind == BodyKind::Dynamic
-                && b.awake
-                && (b.bullet || (m.x - s.x).length() > b.ccd_extent)
-        })
+        .zip(sims)
+        .map(|(b, s)| is_fast(b, s))
         .collect();
     for i in 0..bodies.len() {
         if !fast[i] {
             continue;
         }
-        let body = &bodies[i];
-        let sweep = sweep_of(body, &start[i], &motions[i]);
-        let end_pose = Pose::new(
-            motions[i].x - motions[i].q * body.local_center,
-            motions[i].q,
-        );
-        let swept = body
-            .shape
-            .aabb(&sweep.start)
-            .union(&body.shape.aabb(&end_pose));
-        let mut first: Real = 1.0;
-        broad.query_aabb(&swept, |user| {
-            let j = user as usize;
-            let Some(other) = bodies.get(j) else { return };
-            let eligible = j != i
-                && !fast[j]
-                && body.filter.allows(&other.filter)
-                && (other.kind == BodyKind::Static
-                    || (body.bullet && other.kind != BodyKind::Static));
-            if eligible {
-                let still = Sweep {
-                    start: other.pose(),
-                    translation: Vec3::ZERO,
-                    rotation: Vec3::ZERO,
-                    local_center: Vec3::ZERO,
-                };
-                let t = shape_toi(&body.shape, &sweep, &other.shape, &still, slop, first);
-                // Touching from the start (t = 0) is the contact solver's business: stopping
-                // the body there instead froze a forearm lying on the floor in place while
-                // its joint pulled it up at 12 m/s, until the joint tore and the ragdoll
-                // exploded.
-                if t > 0.0 {
-                    first = first.min(t);
-                }
-            }
-        });
+        let (body, s) = (&bodies[i], solver_bodies.sims[i]);
+        let sweep = sweep_of(body, &s);
+        let first = first_impact(bodies, i, &sweep, &s, &fast, broad, slop);
         if first < 1.0 {
-            let (s, m) = (start[i], motions[i]);
-            motions[i].x = s.x + (m.x - s.x) * first;
-            motions[i].q = (quat_from_rotation_vector(sweep.rotation * first) * s.q).normalize();
-            motions[i].w = body.omega_from_momentum(motions[i].q, m.l);
+            let sim = &mut solver_bodies.sims[i];
+            sim.x = s.x0 + (s.x - s.x0) * first;
+            sim.q = (quat_from_rotation_vector(sweep.rotation * first) * s.q0).normalize();
+            solver_bodies.states[i].w = body.omega_from_momentum(sim.q, s.l);
         }
     }
+}
+
+/// The earliest impact parameter in [0, 1) of body `i`'s sweep against the bodies it may
+/// not pass (static ones; for a bullet, every body that is not fast itself), or 1.
+fn first_impact(
+    bodies: &[Body],
+    i: usize,
+    sweep: &Sweep,
+    s: &BodySim,
+    fast: &[bool],
+    broad: &BroadPhase,
+    slop: Real,
+) -> Real {
+    let body = &bodies[i];
+    let end_pose = Pose::new(s.x - s.q * body.local_center, s.q);
+    let swept = body
+        .shape
+        .aabb(&sweep.start)
+        .union(&body.shape.aabb(&end_pose));
+    let mut first: Real = 1.0;
+    broad.query_aabb(&swept, |user| {
+        let j = user as usize;
+        let Some(other) = bodies.get(j) else { return };
+        let eligible = j != i
+            && !fast[j]
+            && body.filter.allows(&other.filter)
+            && (other.kind == BodyKind::Static || (body.bullet && other.kind != BodyKind::Static));
+        if eligible {
+            let still = Sweep {
+                start: other.pose(),
+                translation: Vec3::ZERO,
+                rotation: Vec3::ZERO,
+                local_center: Vec3::ZERO,
+            };
+            let t = shape_toi(&body.shape, sweep, &other.shape, &still, slop, first);
+            // Touching from the start (t = 0) is the contact solver's business: stopping
+            // the body there instead froze a forearm lying on the floor in place while
+            // its joint pulled it up at 12 m/s, until the joint tore and the ragdoll
+            // exploded.
+            if t > 0.0 {
+                first = first.min(t);
+            }
+        }
+    });
+    first
 }
 
 /// Earliest impact parameter of a moving shape against a resting one, or `limit`.

@@ -1,9 +1,9 @@
 //! Conserved and monitored quantities: energy, momentum, angular momentum, state hash.
 
+use crate::body::Motion;
 use crate::body::{Body, BodyKind};
 use crate::force::{spring_potential, Force};
 use crate::id::BodyId;
-use crate::integrate::Motion;
 use crate::math::{Real, Vec3};
 
 /// Energies (J) and momenta of a world's dynamic bodies.

@@ -4,10 +4,10 @@
 //! multi-stage integrators can evaluate it at their intermediate states. Forces are world
 //! frame (N), torques world frame about the centre of mass (N·m).
 
+use crate::body::Motion;
 use crate::body::{Body, BodyKind};
 use crate::error::{check, Result};
 use crate::id::BodyId;
-use crate::integrate::Motion;
 use crate::math::{Real, Vec3};
 
 /// Force and torque on one body (world frame, torque about the centre of mass).

@@ -33,7 +33,10 @@ pub mod query;
 pub mod shape;
 pub mod solver;
 pub(crate) mod speculative;
+mod step;
 pub mod world;
+mod world_bodies;
+mod world_forces;
 mod world_joints;
 pub mod world_query;
 

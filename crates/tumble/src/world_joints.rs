@@ -33,7 +33,7 @@ impl World {
             None => None,
         };
         let pose = |i: usize| {
-            let p = self.bodies[i].pose();
+            let p = self.bodies.list[i].pose();
             (p.position, p.rotation)
         };
         let joint = joint::build(def, pose(a), b.map(pose));

@@ -57,7 +57,8 @@ impl World {
     /// length). Rays starting inside a body hit it at t = 0.
     pub fn cast_ray(&self, ray: &Ray, max_t: Real, filter: &QueryFilter) -> Option<WorldRayHit> {
         let mut best: Option<WorldRayHit> = None;
-        self.broad_phase
+        self.collision
+            .broad_phase
             .cast_ray(ray.origin, ray.direction, max_t, |user, limit| {
                 let Some((id, body)) = self.sees(user as usize, filter) else {
                     return limit;
@@ -76,7 +77,8 @@ impl World {
     /// Every body the ray hits with t in [0, max_t], nearest first (one hit per body).
     pub fn cast_ray_all(&self, ray: &Ray, max_t: Real, filter: &QueryFilter) -> Vec<WorldRayHit> {
         let mut hits = Vec::new();
-        self.broad_phase
+        self.collision
+            .broad_phase
             .cast_ray(ray.origin, ray.direction, max_t, |user, limit| {
                 if let Some((id, body)) = self.sees(user as usize, filter) {
                     if let Some(hit) = query::cast_ray(&body.shape, &body.pose(), ray, max_t, true)
@@ -93,7 +95,8 @@ impl World {
     /// Bodies containing the world point, in body order.
     pub fn query_point(&self, point: Vec3, filter: &QueryFilter) -> Vec<BodyId> {
         let mut found = Vec::new();
-        self.broad_phase
+        self.collision
+            .broad_phase
             .query_aabb(&Aabb::new(point, point), |user| {
                 if let Some((id, body)) = self.sees(user as usize, filter) {
                     if query::contains_point(&body.shape, &body.pose(), point) {
@@ -107,7 +110,7 @@ impl World {
     /// Bodies whose tight bounding box overlaps `aabb`, in body order.
     pub fn query_aabb(&self, aabb: &Aabb, filter: &QueryFilter) -> Vec<BodyId> {
         let mut found = Vec::new();
-        self.broad_phase.query_aabb(aabb, |user| {
+        self.collision.broad_phase.query_aabb(aabb, |user| {
             if let Some((id, body)) = self.sees(user as usize, filter) {
                 if body.shape.aabb(&body.pose()).overlaps(aabb) {
                     found.push((user, id));
@@ -136,7 +139,7 @@ impl World {
         );
         let swept = start.union(&end);
         let mut best: Option<WorldShapeHit> = None;
-        self.broad_phase.query_aabb(&swept, |user| {
+        self.collision.broad_phase.query_aabb(&swept, |user| {
             let Some((id, body)) = self.sees(user as usize, filter) else {
                 return;
             };

@@ -20,7 +20,7 @@ mod implicit_euler;
 mod rotation;
 mod symplectic;
 
-use crate::body::{Body, BodyKind};
+use crate::body::{Body, BodyKind, Motion};
 use crate::force::{self, Force, ForceCallback, ForceContext, Wrench};
 use crate::id::BodyId;
 use crate::math::{quat_rate, Quat, Real, Vec3, Vec4};
@@ -92,33 +92,6 @@ impl Integrator {
     /// Every name, comma separated, for error messages and help.
     pub fn names() -> String {
         Integrator::ALL.map(|i| i.name()).join(", ")
-    }
-}
-
-/// One body's dynamic state at some time (a step's start, or an integrator's stage).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Motion {
-    /// Centre of mass (m).
-    pub x: Vec3,
-    /// Orientation.
-    pub q: Quat,
-    /// Velocity of the centre of mass (m/s).
-    pub v: Vec3,
-    /// Angular momentum about the centre of mass (kg·m²/s).
-    pub l: Vec3,
-    /// Angular velocity (rad/s): derived from `l` for dynamic bodies.
-    pub w: Vec3,
-}
-
-impl Motion {
-    pub fn of(body: &Body) -> Motion {
-        Motion {
-            x: body.com,
-            q: body.orientation,
-            v: body.velocity,
-            l: body.angular_momentum,
-            w: body.angular_velocity,
-        }
     }
 }
 
@@ -231,8 +204,39 @@ const ZERO_MOTION: Motion = Motion {
     w: Vec3::ZERO,
 };
 
-/// Advances `motions` (one per body of `sys`) from time `t` by `h` with `integrator`.
-/// `verlet` holds the Störmer–Verlet memory of each body and whether it is still valid.
+/// What an integrator carries from one step to the next: Störmer–Verlet's previous
+/// position and half-step angular momentum, per body. Lasting state of the world (a
+/// snapshot must keep it); every edit that breaks the sequence of equal steps it assumes
+/// forgets it: a body edited from outside, a body the solver moved, a change of method.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct IntegratorMemory {
+    verlet: Vec<Option<VerletMemory>>,
+}
+
+impl IntegratorMemory {
+    /// Room for one more body (created last), with no memory.
+    pub fn push(&mut self) {
+        self.verlet.push(None);
+    }
+
+    /// Drops dense body `i`'s entry (the body is removed).
+    pub fn remove(&mut self, i: usize) {
+        self.verlet.remove(i);
+    }
+
+    /// Forgets dense body `i`'s memory: its next step starts the method afresh.
+    pub fn forget(&mut self, i: usize) {
+        self.verlet[i] = None;
+    }
+
+    /// Forgets every body's memory.
+    pub fn clear(&mut self) {
+        self.verlet.iter_mut().for_each(|m| *m = None);
+    }
+}
+
+/// Advances `motions` (one per body of `sys`) from time `t` by `dt` with `integrator`.
+/// `memory` holds the Störmer–Verlet memory of each body and whether it is still valid.
 /// `discarded` marks bodies whose result the caller will throw away (the solver moves
 /// them, or they sleep); methods whose bodies do not read each other's intermediate
 /// states may leave them out (symplectic Euler does: as the rain lands, drifting bodies
@@ -241,8 +245,8 @@ pub(crate) fn advance(
     integrator: Integrator,
     sys: &mut System<'_>,
     motions: &mut [Motion],
-    verlet: &mut [Option<symplectic::VerletMemory>],
-    (t, h): (Real, Real),
+    memory: &mut IntegratorMemory,
+    (t, dt): (Real, Real),
     scratch: &mut Scratch,
     discarded: &[bool],
 ) {
@@ -250,15 +254,15 @@ pub(crate) fn advance(
     scratch.start.extend_from_slice(motions);
     scratch.resize(motions.len());
     match integrator {
-        Integrator::ExplicitEuler => explicit::explicit_euler(sys, motions, t, h, scratch),
-        Integrator::Midpoint => explicit::midpoint(sys, motions, t, h, scratch),
-        Integrator::Rk4 => explicit::rk4(sys, motions, t, h, scratch),
+        Integrator::ExplicitEuler => explicit::explicit_euler(sys, motions, t, dt, scratch),
+        Integrator::Midpoint => explicit::midpoint(sys, motions, t, dt, scratch),
+        Integrator::Rk4 => explicit::rk4(sys, motions, t, dt, scratch),
         Integrator::SymplecticEuler => {
-            symplectic::symplectic_euler(sys, motions, t, h, scratch, discarded)
+            symplectic::symplectic_euler(sys, motions, t, dt, scratch, discarded)
         }
-        Integrator::VelocityVerlet => symplectic::velocity_verlet(sys, motions, t, h, scratch),
-        Integrator::Verlet => symplectic::verlet(sys, motions, verlet, t, h, scratch),
-        Integrator::ImplicitEuler => implicit_euler::step(sys, motions, t, h, scratch),
+        Integrator::VelocityVerlet => symplectic::velocity_verlet(sys, motions, t, dt, scratch),
+        Integrator::Verlet => symplectic::verlet(sys, motions, &mut memory.verlet, t, dt, scratch),
+        Integrator::ImplicitEuler => implicit_euler::step(sys, motions, t, dt, scratch),
     }
     // Prescribed motion is known exactly; no method should add its own error to it.
     for ((m, start), body) in motions.iter_mut().zip(&scratch.start).zip(sys.bodies) {
@@ -266,18 +270,19 @@ pub(crate) fn advance(
             *m = *start;
         }
     }
-    move_kinematic(sys.bodies, motions, h);
+    move_kinematic(sys.bodies, motions, dt);
 }
 
-/// Moves kinematic bodies exactly along their prescribed velocities: x + h v, exp(hω/2) q.
-pub(crate) fn move_kinematic(bodies: &[Body], motions: &mut [Motion], h: Real) {
+/// Moves kinematic bodies exactly along their prescribed velocities: x + dt v,
+/// exp(dt ω/2) q.
+fn move_kinematic(bodies: &[Body], motions: &mut [Motion], dt: Real) {
     for (m, body) in motions.iter_mut().zip(bodies) {
         if body.kind == BodyKind::Kinematic {
-            m.x += m.v * h;
-            m.q = rotation::exact_spin(m.w, m.q, h);
+            m.x += m.v * dt;
+            m.q = rotation::exact_spin(m.w, m.q, dt);
         }
     }
 }
 
 pub(crate) use rotation::{drift as rotor_drift, exact_spin};
-pub(crate) use symplectic::VerletMemory;
+use symplectic::VerletMemory;

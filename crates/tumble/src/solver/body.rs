@@ -1,10 +1,58 @@
-//! The solver's view of a body, split as in Box2D v3: a small `BodyState` that every
-//! constraint pass reads and writes (velocities and the motion since the step began), and
-//! a `BodySim` with what changes only between substeps.
+//! The step's one representation of a body, split as in Box2D v3: a small `BodyState`
+//! that every constraint pass reads and writes (velocities and the motion since the step
+//! began), and a `BodySim` with what changes only between substeps.
+//!
+//! Every body of the world has one of each for the whole step ([`SolverBodies`]): gathered
+//! from its `Body` once when the step begins, advanced in place by the free integrator
+//! (bodies touching nothing), the solver (bodies in contact or joined), the prescribed
+//! motion of kinematic bodies and the continuous-collision sweep, and scattered back once
+//! when the step ends. `x0`, `q0` stay the pose at the step's start throughout.
 
-use crate::body::{Body, BodyKind};
-use crate::integrate::Motion;
+use crate::body::{Body, BodyKind, Motion};
 use crate::math::{Mat3, Quat, Real, Vec3};
+
+/// Every body of the world as the step sees it, in the world's dense order.
+#[derive(Default)]
+pub(crate) struct SolverBodies {
+    pub sims: Vec<BodySim>,
+    pub states: Vec<BodyState>,
+}
+
+impl SolverBodies {
+    /// Gathers every body at the step's start; `solved[i]` marks the bodies the solver
+    /// will move (their world inertia is needed; the others' is left zero).
+    pub fn gather(&mut self, bodies: &[Body], solved: &[bool]) {
+        self.sims.clear();
+        self.states.clear();
+        for (b, &solved) in bodies.iter().zip(solved) {
+            let (sim, state) = BodySim::new(b, solved);
+            self.sims.push(sim);
+            self.states.push(state);
+        }
+    }
+
+    /// Body `i`'s state as the integrators' ODE vector sees it.
+    pub fn motion(&self, i: usize) -> Motion {
+        let (s, st) = (&self.sims[i], &self.states[i]);
+        Motion {
+            x: s.x,
+            q: s.q,
+            v: st.v,
+            l: s.l,
+            w: st.w,
+        }
+    }
+
+    /// Sets body `i`'s state from an integrator's result.
+    pub fn set_motion(&mut self, i: usize, m: &Motion) {
+        let (s, st) = (&mut self.sims[i], &mut self.states[i]);
+        s.x = m.x;
+        s.q = m.q;
+        s.l = m.l;
+        st.v = m.v;
+        st.w = m.w;
+    }
+}
 
 /// What constraint passes touch: kept small and contiguous.
 #[derive(Debug, Clone, Copy)]
@@ -46,7 +94,8 @@ pub(crate) struct BodySim {
 }
 
 impl BodySim {
-    pub fn new(body: &Body, m: &Motion, solved: bool) -> (BodySim, BodyState) {
+    pub fn new(body: &Body, solved: bool) -> (BodySim, BodyState) {
+        let m = Motion::of(body);
         let moves = solved && body.kind == BodyKind::Dynamic;
         let (inertia, inv_inertia) = if !moves {
             (Mat3::ZERO, Mat3::ZERO)

@@ -1,4 +1,4 @@
-//! The constraint solver: contacts (and, later, joints) as impulses inside substeps.
+//! The constraint solver: contacts and joints as impulses inside substeps.
 //!
 //! One step of `dt` with n substeps of h = dt/n, for the bodies that touch something:
 //!
@@ -27,16 +27,18 @@ mod softness;
 
 pub use softness::Softness;
 
-use body::{BodySim, BodyState};
+pub(crate) use body::{BodySim, BodyState, SolverBodies};
 use contact::{BiasRule, ContactConstraint, PairData, Points};
 use joint::{JointConstraint, JointPass};
 
+use crate::body::Motion;
 use crate::body::{Body, BodyKind};
 use crate::contact_cache::Contact;
 use crate::force::Wrench;
-use crate::integrate::{exact_spin, rotor_drift, Motion, System};
+use crate::integrate::{exact_spin, rotor_drift, System};
 use crate::joint::Joint;
 use crate::math::{Mat3, Real, Vec3};
+use crate::step::StepTime;
 use std::ops::Range;
 
 /// Which velocity solver handles contacts.
@@ -114,23 +116,19 @@ pub(crate) struct StepInput<'a, 'b> {
     pub system: &'a mut System<'b>,
     pub settings: &'a SolverSettings,
     pub scales: &'a Scales,
-    /// Which bodies the solver advances (dynamic bodies touching something).
-    pub solved: &'a [bool],
     /// Contacts to leave out this step (speculative ones the bodies will not reach).
     pub ghosts: &'a [bool],
     /// The world's joints, and the dense indices of each one's bodies (`None`: the world
     /// or a broken joint's absent partner).
     pub joints: &'a mut [Joint],
     pub joint_bodies: &'a [[Option<usize>; 2]],
-    pub time: Real,
-    pub dt: Real,
+    /// The step's time, length and substep.
+    pub time: &'a StepTime,
 }
 
 /// Buffers reused from step to step.
 #[derive(Default)]
 pub(crate) struct Solver {
-    sims: Vec<BodySim>,
-    states: Vec<BodyState>,
     /// The states at the step's start, for the bounce replay.
     start_states: Vec<BodyState>,
     moving: Vec<bool>,
@@ -151,65 +149,43 @@ pub(crate) struct Solver {
 }
 
 impl Solver {
-    /// Advances the solved bodies of `motions` (their start-of-step states) through the
-    /// step, and writes every contact's impulses back.
+    /// Stage of the step: advances the bodies the solver moves (`moves` in `bodies`, at
+    /// their start-of-step states) through the substeps, in place. Reads the contacts,
+    /// joints, forces and settings of `input`; writes the moved bodies' states, every
+    /// solved contact's impulses and every solved joint's reaction.
     pub fn step(
         &mut self,
-        input: StepInput<'_, '_>,
-        motions: &mut [Motion],
+        mut input: StepInput<'_, '_>,
+        bodies: &mut SolverBodies,
         contacts: &mut [Contact],
     ) {
-        let bodies = input.system.bodies;
-        let substeps = input.settings.substeps.max(1);
-        let h = input.dt / substeps as Real;
-        self.sims.clear();
-        self.states.clear();
-        for ((b, m), &solved) in bodies.iter().zip(motions.iter()).zip(input.solved) {
-            let (sim, state) = BodySim::new(b, m, solved);
-            self.sims.push(sim);
-            self.states.push(state);
-        }
-        self.start_states.clone_from(&self.states);
-        let rule = bias_rule(input.settings, input.scales, h);
-        self.find_heavy_islands(contacts, input.ghosts, input.joints, input.joint_bodies);
-        self.prepare(contacts, input.ghosts);
-        self.prepare_joints(bodies, input.joints, input.joint_bodies);
-        let (solve_pass, relax_pass) = joint_passes(input.settings, h);
-        let any_split = self.split_kicks();
-        for i in 0..substeps {
-            let t = input.time + i as Real * h;
-            // After a split kick's second half the forces are those of this substep's start.
-            self.kick(input.system, t, h, i == 0 || !any_split, false);
-            for j in &mut self.joints {
-                j.warm_start(&self.sims, &mut self.states);
-            }
-            contact_wide::warm_start(&self.constraints, &self.points, &mut self.states);
-            let iterations = input.settings.iterations;
-            let relax = input.settings.kind == SolverKind::SoftStep && iterations > 0;
-            self.passes(iterations, (&rule, &solve_pass), true, !relax);
-            self.drift(bodies, h);
-            if any_split {
-                self.kick(input.system, t + h, h, true, true);
-            }
-            if relax {
-                self.passes(iterations, (&rule, &relax_pass), false, true);
-            }
-            if iterations == 0 {
-                ContactConstraint::add_to_totals(&self.points.hot, &mut self.points.cold);
-            }
-            for j in &mut self.joints {
-                j.add_to_totals(&self.sims);
-            }
+        let world_bodies = input.system.bodies;
+        let time = input.time;
+        self.start_states.clone_from(&bodies.states);
+        let rule = bias_rule(input.settings, input.scales, time);
+        self.find_heavy_islands(
+            bodies,
+            contacts,
+            input.ghosts,
+            input.joints,
+            input.joint_bodies,
+        );
+        self.prepare(bodies, contacts, input.ghosts);
+        self.prepare_joints(bodies, world_bodies, input.joints, input.joint_bodies);
+        let passes = joint_passes(input.settings, time);
+        let any_split = self.split_kicks(bodies);
+        for i in 0..time.substeps {
+            self.substep(bodies, &mut input, (&rule, &passes), i, any_split);
         }
         for j in &self.joints {
-            j.store(&mut input.joints[j.joint], input.dt);
+            j.store(&mut input.joints[j.joint], time.dt);
         }
         self.moving.clear();
-        self.moving.extend(self.sims.iter().map(|s| s.moves));
+        self.moving.extend(bodies.sims.iter().map(|s| s.moves));
         restitution::resolve_bounces(
             &self.constraints,
             &mut self.points,
-            &mut self.states,
+            &mut bodies.states,
             &self.start_states,
             &self.moving,
             input.scales.restitution_threshold,
@@ -217,21 +193,51 @@ impl Solver {
         for c in &self.constraints {
             c.store_impulses(&self.points, &mut contacts[c.contact]);
         }
-        for ((m, sim), (state, body)) in motions
+        for ((sim, state), body) in bodies
+            .sims
             .iter_mut()
-            .zip(&mut self.sims)
-            .zip(self.states.iter().zip(bodies))
+            .zip(&mut bodies.states)
+            .zip(world_bodies)
         {
             if sim.moves {
                 sim.sync_momentum(state);
-                *m = Motion {
-                    x: sim.x,
-                    q: sim.q,
-                    v: state.v,
-                    l: sim.l,
-                    w: body.omega_from_momentum(sim.q, sim.l),
-                };
+                state.w = body.omega_from_momentum(sim.q, sim.l);
             }
+        }
+    }
+
+    /// Substep `i`: kick, warm start, solve, drift, relax (see the module header).
+    fn substep(
+        &mut self,
+        bodies: &mut SolverBodies,
+        input: &mut StepInput<'_, '_>,
+        (rule, (solve_pass, relax_pass)): (&BiasRule, &(JointPass, JointPass)),
+        i: u32,
+        any_split: bool,
+    ) {
+        let (h, world_bodies) = (input.time.h, input.system.bodies);
+        let t = input.time.t + i as Real * h;
+        // After a split kick's second half the forces are those of this substep's start.
+        self.kick(bodies, input.system, t, h, (i == 0 || !any_split, false));
+        for j in &mut self.joints {
+            j.warm_start(&bodies.sims, &mut bodies.states);
+        }
+        contact_wide::warm_start(&self.constraints, &self.points, &mut bodies.states);
+        let iterations = input.settings.iterations;
+        let relax = input.settings.kind == SolverKind::SoftStep && iterations > 0;
+        self.passes(bodies, iterations, (rule, solve_pass), true, !relax);
+        self.drift(bodies, world_bodies, h);
+        if any_split {
+            self.kick(bodies, input.system, t + h, h, (true, true));
+        }
+        if relax {
+            self.passes(bodies, iterations, (rule, relax_pass), false, true);
+        }
+        if iterations == 0 {
+            ContactConstraint::add_to_totals(&self.points.hot, &mut self.points.cold);
+        }
+        for j in &mut self.joints {
+            j.add_to_totals(&bodies.sims);
         }
     }
 
@@ -241,6 +247,7 @@ impl Solver {
     /// them to the step's totals on its way instead of a separate walk over every point.
     fn passes(
         &mut self,
+        bodies: &mut SolverBodies,
         iterations: u32,
         rules: (&BiasRule, &JointPass),
         bias: bool,
@@ -258,10 +265,10 @@ impl Solver {
         for (contacts, joints, count) in parts {
             for k in 0..count {
                 for j in &mut self.joints[joints.clone()] {
-                    j.solve(&self.sims, &mut self.states, joint_pass);
+                    j.solve(&bodies.sims, &mut bodies.states, joint_pass);
                 }
                 let last = totals && k + 1 == count;
-                self.solve_pass(contacts.clone(), rule, bias, last);
+                self.solve_pass(bodies, contacts.clone(), rule, bias, last);
             }
         }
     }
@@ -270,6 +277,7 @@ impl Solver {
     /// contacts and joints the step will solve.
     fn find_heavy_islands(
         &mut self,
+        bodies: &SolverBodies,
         contacts: &[Contact],
         ghosts: &[bool],
         joints: &[Joint],
@@ -289,22 +297,22 @@ impl Solver {
                     _ => None,
                 });
         (self.heavy, self.heavy_passes) =
-            mass_ratio::heavy_islands(&self.sims, touching.chain(joined)).unwrap_or_default();
+            mass_ratio::heavy_islands(&bodies.sims, touching.chain(joined)).unwrap_or_default();
     }
 
-    fn prepare(&mut self, contacts: &[Contact], ghosts: &[bool]) {
+    fn prepare(&mut self, bodies: &SolverBodies, contacts: &[Contact], ghosts: &[bool]) {
         self.constraints.clear();
         self.points.clear();
-        let order = self.colour_order(contacts, ghosts);
+        let order = self.colour_order(&bodies.sims, contacts, ghosts);
         self.heavy_contacts = order.partition_point(|&(heavy, _, _)| !heavy);
         for (_, colour, i) in order {
             let c = &contacts[i];
             let (a, b) = (c.index_a as usize, c.index_b as usize);
-            let (sa, sb) = (&self.sims[a], &self.sims[b]);
+            let (sa, sb) = (&bodies.sims[a], &bodies.sims[b]);
             let friction = (sa.friction * sb.friction).sqrt();
             let restitution = sa.restitution.max(sb.restitution);
             let pose = |k: usize| {
-                let s = &self.sims[k];
+                let s = &bodies.sims[k];
                 crate::geometry::Pose::new(s.x - s.q * s.local_center, s.q)
             };
             let pair = PairData {
@@ -316,7 +324,7 @@ impl Solver {
                 (i, colour),
                 c,
                 &pair,
-                (&self.sims, &self.states),
+                (&bodies.sims, &bodies.states),
                 &mut self.points,
             ));
         }
@@ -331,9 +339,9 @@ impl Solver {
     /// motion is Störmer–Verlet with the solve and the relax pass enforcing the position and
     /// velocity constraints (RATTLE): second order, where symplectic Euler's O(h) energy
     /// wobble moved a 2 rad pendulum's energy by 1.1 %. Returns whether any body splits.
-    fn split_kicks(&mut self) -> bool {
+    fn split_kicks(&mut self, bodies: &SolverBodies) -> bool {
         self.split_kick.clear();
-        self.split_kick.extend(self.sims.iter().map(|s| s.moves));
+        self.split_kick.extend(bodies.sims.iter().map(|s| s.moves));
         for c in &self.constraints {
             let (a, b) = c.bodies();
             self.split_kick[a] = false;
@@ -343,7 +351,13 @@ impl Solver {
     }
 
     /// The joints that join at least one body the solver moves, in creation order.
-    fn prepare_joints(&mut self, bodies: &[Body], joints: &[Joint], links: &[[Option<usize>; 2]]) {
+    fn prepare_joints(
+        &mut self,
+        solver_bodies: &SolverBodies,
+        bodies: &[Body],
+        joints: &[Joint],
+        links: &[[Option<usize>; 2]],
+    ) {
         self.joints.clear();
 
         for (i, (joint, link)) in joints.iter().zip(links).enumerate() {
@@ -356,7 +370,7 @@ impl Solver {
                 joint,
                 [(link[0], center(link[0])), (link[1], center(link[1]))],
             );
-            if c.active(&self.sims) {
+            if c.active(&solver_bodies.sims) {
                 self.joints.push(c);
             }
         }
@@ -377,18 +391,23 @@ impl Solver {
     /// Deterministic: colours depend only on the contacts' order, itself deterministic.
     /// Contacts of islands with a large mass ratio come last, for their extra passes.
     /// Colour 63 keeps the contacts' order.
-    fn colour_order(&self, contacts: &[Contact], ghosts: &[bool]) -> Vec<(bool, u32, usize)> {
-        let mut used = vec![0u64; self.sims.len()];
+    fn colour_order(
+        &self,
+        sims: &[BodySim],
+        contacts: &[Contact],
+        ghosts: &[bool],
+    ) -> Vec<(bool, u32, usize)> {
+        let mut used = vec![0u64; sims.len()];
         let mut coloured = Vec::with_capacity(contacts.len());
         for (i, c) in contacts.iter().enumerate() {
             let (a, b) = (c.index_a as usize, c.index_b as usize);
-            if idle(c, i, ghosts) || !(self.sims[a].moves || self.sims[b].moves) {
+            if idle(c, i, ghosts) || !(sims[a].moves || sims[b].moves) {
                 continue;
             }
-            let mask = |k: usize| if self.sims[k].moves { used[k] } else { 0 };
+            let mask = |k: usize| if sims[k].moves { used[k] } else { 0 };
             let colour = (!(mask(a) | mask(b))).trailing_zeros().min(63);
             for k in [a, b] {
-                if self.sims[k].moves {
+                if sims[k].moves {
                     used[k] |= 1u64 << colour;
                 }
             }
@@ -408,22 +427,36 @@ impl Solver {
 
     /// One pass over the constraints in `range`, in colour order; consecutive constraints
     /// of one colour are solved several at a time in lanes (see `contact_wide`).
-    fn solve_pass(&mut self, range: Range<usize>, rule: &BiasRule, bias: bool, totals: bool) {
+    fn solve_pass(
+        &mut self,
+        bodies: &mut SolverBodies,
+        range: Range<usize>,
+        rule: &BiasRule,
+        bias: bool,
+        totals: bool,
+    ) {
         let pass = contact_wide::Pass { rule, bias, totals };
-        let (cs, points, states) = (&self.constraints, &mut self.points, &mut self.states);
+        let (cs, points, states) = (&self.constraints, &mut self.points, &mut bodies.states);
         contact_wide::solve_pass(cs, range, points, states, pass);
     }
 
     /// v += h F/m, L += h N, over the substep's start (`end` false) or end: bodies in
     /// contact take the whole kick first (symplectic Euler), the others half at each end.
-    fn kick(&mut self, system: &mut System<'_>, t: Real, h: Real, evaluate: bool, end: bool) {
+    fn kick(
+        &mut self,
+        bodies: &mut SolverBodies,
+        system: &mut System<'_>,
+        t: Real,
+        h: Real,
+        (evaluate, end): (bool, bool),
+    ) {
         if evaluate {
-            self.evaluate_forces(system, t);
+            self.evaluate_forces(bodies, system, t);
         }
-        for ((((sim, state), w), body), &split) in self
+        for ((((sim, state), w), body), &split) in bodies
             .sims
             .iter_mut()
-            .zip(&mut self.states)
+            .zip(&mut bodies.states)
             .zip(&self.wrench)
             .zip(system.bodies)
             .zip(&self.split_kick)
@@ -444,24 +477,19 @@ impl Solver {
     }
 
     /// Every force element and callback at the solver's current state and time `t`.
-    fn evaluate_forces(&mut self, system: &mut System<'_>, t: Real) {
+    fn evaluate_forces(&mut self, bodies: &SolverBodies, system: &mut System<'_>, t: Real) {
         self.motions.clear();
         self.motions
-            .extend(self.sims.iter().zip(&self.states).map(|(s, st)| Motion {
-                x: s.x,
-                q: s.q,
-                v: st.v,
-                l: s.l,
-                w: st.w,
-            }));
+            .extend((0..bodies.sims.len()).map(|i| bodies.motion(i)));
         self.wrench.resize(self.motions.len(), Wrench::default());
         system.wrenches(t, &self.motions, &mut self.wrench);
     }
 
     /// x += h v and the exact torque-free rotation with L; kinematic bodies move too, so
     /// contacts see them where they are.
-    fn drift(&mut self, bodies: &[Body], h: Real) {
-        for ((sim, state), body) in self.sims.iter_mut().zip(&mut self.states).zip(bodies) {
+    fn drift(&mut self, solver_bodies: &mut SolverBodies, bodies: &[Body], h: Real) {
+        let (sims, states) = (&mut solver_bodies.sims, &mut solver_bodies.states);
+        for ((sim, state), body) in sims.iter_mut().zip(states.iter_mut()).zip(bodies) {
             match (sim.moves, body.kind) {
                 (true, _) => {
                     sim.sync_momentum(state);
@@ -496,19 +524,18 @@ fn idle(c: &Contact, i: usize, ghosts: &[bool]) -> bool {
 /// How joints treat drift in the solve and the relax passes: the joint spring (capped at
 /// a quarter of the substep rate) then none, for the soft step; Baumgarte then nothing
 /// (there is no relax pass) for PGS.
-fn joint_passes(settings: &SolverSettings, h: Real) -> (JointPass, JointPass) {
-    let inv_h = 1.0 / h;
+fn joint_passes(settings: &SolverSettings, time: &StepTime) -> (JointPass, JointPass) {
     let soft = biased_softness(
         settings,
         settings.joint_hertz,
         settings.joint_damping_ratio,
-        h,
+        time,
     );
     let pass = |soft, bias| JointPass {
         soft,
         bias,
-        inv_h,
-        h,
+        inv_h: time.inv_h,
+        h: time.h,
     };
     (pass(soft, true), pass(Softness::RIGID, false))
 }
@@ -516,12 +543,16 @@ fn joint_passes(settings: &SolverSettings, h: Real) -> (JointPass, JointPass) {
 /// Position correction in a biased pass: for the soft step a spring of `hertz` (capped at
 /// a quarter of the substep rate, as in Box2D) and damping ratio `zeta`; for PGS the rigid
 /// row with Baumgarte's β/h.
-fn biased_softness(settings: &SolverSettings, hertz: Real, zeta: Real, h: Real) -> Softness {
-    let inv_h = 1.0 / h;
+fn biased_softness(
+    settings: &SolverSettings,
+    hertz: Real,
+    zeta: Real,
+    time: &StepTime,
+) -> Softness {
     match settings.kind {
-        SolverKind::SoftStep => Softness::new(hertz.min(0.25 * inv_h), zeta, h),
+        SolverKind::SoftStep => Softness::new(hertz.min(0.25 * time.inv_h), zeta, time.h),
         SolverKind::Pgs => Softness {
-            bias_rate: settings.baumgarte * inv_h,
+            bias_rate: settings.baumgarte * time.inv_h,
             mass_scale: 1.0,
             impulse_scale: 0.0,
         },
@@ -529,15 +560,14 @@ fn biased_softness(settings: &SolverSettings, hertz: Real, zeta: Real, h: Real) 
 }
 
 /// Contacts' position correction and the lengths and speeds they work with.
-fn bias_rule(settings: &SolverSettings, scales: &Scales, h: Real) -> BiasRule {
-    let inv_h = 1.0 / h;
+fn bias_rule(settings: &SolverSettings, scales: &Scales, time: &StepTime) -> BiasRule {
     BiasRule {
-        inv_h,
+        inv_h: time.inv_h,
         softness: biased_softness(
             settings,
             settings.contact_hertz,
             settings.contact_damping_ratio,
-            h,
+            time,
         ),
         slop: if settings.kind == SolverKind::Pgs {
             scales.linear_slop
