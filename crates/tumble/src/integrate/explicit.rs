@@ -16,56 +16,56 @@ fn eval(sys: &mut System<'_>, t: Real, state: &[Motion], wrench: &mut [Wrench], 
     sys.rates(state, wrench, out);
 }
 
-/// `out = base + h · rate`, with q renormalised and ω re-derived.
-fn euler_update(sys: &System<'_>, base: &[Motion], rate: &[Rate], h: Real, out: &mut [Motion]) {
+/// `out = base + dt · rate`, with q renormalised and ω re-derived.
+fn euler_update(sys: &System<'_>, base: &[Motion], rate: &[Rate], dt: Real, out: &mut [Motion]) {
     for (((o, b), r), body) in out.iter_mut().zip(base).zip(rate).zip(sys.bodies) {
-        o.x = b.x + r.dx * h;
-        o.v = b.v + r.dv * h;
-        o.l = b.l + r.dl * h;
-        o.q = vec4_to_quat(quat_to_vec4(b.q) + r.dq * h).normalize();
+        o.x = b.x + r.dx * dt;
+        o.v = b.v + r.dv * dt;
+        o.l = b.l + r.dl * dt;
+        o.q = vec4_to_quat(quat_to_vec4(b.q) + r.dq * dt).normalize();
         o.w = b.w;
         refresh_omega(body, o);
     }
 }
 
-/// y₊ = y + h f(t, y).
+/// y₊ = y + dt f(t, y).
 pub(super) fn explicit_euler(
     sys: &mut System<'_>,
     motions: &mut [Motion],
     t: Real,
-    h: Real,
+    dt: Real,
     s: &mut Scratch,
 ) {
     let [k1, ..] = &mut s.rates;
     eval(sys, t, &s.start, &mut s.wrench, k1);
-    euler_update(sys, &s.start, k1, h, motions);
+    euler_update(sys, &s.start, k1, dt, motions);
 }
 
-/// y₊ = y + h f(t + h/2, y + h/2 f(t, y)).
+/// y₊ = y + dt f(t + dt/2, y + dt/2 f(t, y)).
 pub(super) fn midpoint(
     sys: &mut System<'_>,
     motions: &mut [Motion],
     t: Real,
-    h: Real,
+    dt: Real,
     s: &mut Scratch,
 ) {
     let [k1, k2, ..] = &mut s.rates;
     eval(sys, t, &s.start, &mut s.wrench, k1);
-    euler_update(sys, &s.start, k1, 0.5 * h, &mut s.stage);
-    eval(sys, t + 0.5 * h, &s.stage, &mut s.wrench, k2);
-    euler_update(sys, &s.start, k2, h, motions);
+    euler_update(sys, &s.start, k1, 0.5 * dt, &mut s.stage);
+    eval(sys, t + 0.5 * dt, &s.stage, &mut s.wrench, k2);
+    euler_update(sys, &s.start, k2, dt, motions);
 }
 
-/// Classic RK4: y₊ = y + h/6 (k₁ + 2k₂ + 2k₃ + k₄).
-pub(super) fn rk4(sys: &mut System<'_>, motions: &mut [Motion], t: Real, h: Real, s: &mut Scratch) {
+/// Classic RK4: y₊ = y + dt/6 (k₁ + 2k₂ + 2k₃ + k₄).
+pub(super) fn rk4(sys: &mut System<'_>, motions: &mut [Motion], t: Real, dt: Real, s: &mut Scratch) {
     let [k1, k2, k3, k4] = &mut s.rates;
     eval(sys, t, &s.start, &mut s.wrench, k1);
-    euler_update(sys, &s.start, k1, 0.5 * h, &mut s.stage);
-    eval(sys, t + 0.5 * h, &s.stage, &mut s.wrench, k2);
-    euler_update(sys, &s.start, k2, 0.5 * h, &mut s.stage);
-    eval(sys, t + 0.5 * h, &s.stage, &mut s.wrench, k3);
-    euler_update(sys, &s.start, k3, h, &mut s.stage);
-    eval(sys, t + h, &s.stage, &mut s.wrench, k4);
+    euler_update(sys, &s.start, k1, 0.5 * dt, &mut s.stage);
+    eval(sys, t + 0.5 * dt, &s.stage, &mut s.wrench, k2);
+    euler_update(sys, &s.start, k2, 0.5 * dt, &mut s.stage);
+    eval(sys, t + 0.5 * dt, &s.stage, &mut s.wrench, k3);
+    euler_update(sys, &s.start, k3, dt, &mut s.stage);
+    eval(sys, t + dt, &s.stage, &mut s.wrench, k4);
     // Fold the four slopes into k1 so one Euler update applies their weighted mean.
     for (((a, b), c), d) in k1.iter_mut().zip(k2.iter()).zip(k3.iter()).zip(k4.iter()) {
         a.dx = (a.dx + (b.dx + c.dx) * 2.0 + d.dx) / 6.0;
@@ -73,5 +73,5 @@ pub(super) fn rk4(sys: &mut System<'_>, motions: &mut [Motion], t: Real, h: Real
         a.dq = (a.dq + (b.dq + c.dq) * 2.0 + d.dq) / 6.0;
         a.dl = (a.dl + (b.dl + c.dl) * 2.0 + d.dl) / 6.0;
     }
-    euler_update(sys, &s.start, k1, h, motions);
+    euler_update(sys, &s.start, k1, dt, motions);
 }

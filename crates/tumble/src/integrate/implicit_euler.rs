@@ -1,21 +1,21 @@
 //! Backward (implicit) Euler, linearised: one Newton step of
 //!
 //! ```text
-//! M (u₊ − u) = h f(p₊, u₊),   p₊ = p + h u₊
+//! M (u₊ − u) = dt f(p₊, u₊),   p₊ = p + dt u₊
 //! ```
 //!
 //! with u = (v, ω) per body and f linearised about the start of the step,
-//! f(p₊, u₊) ≈ f₀ − S h u₊ − C Δu, S = −∂f/∂p, C = −∂f/∂u (both positive semidefinite).
+//! f(p₊, u₊) ≈ f₀ − S dt u₊ − C Δu, S = −∂f/∂p, C = −∂f/∂u (both positive semidefinite).
 //! That gives the symmetric positive definite system (Baraff & Witkin's)
 //!
 //! ```text
-//! (M + h C + h² S) Δu = h f₀ − h² S u
+//! (M + dt C + dt² S) Δu = dt f₀ − dt² S u
 //! ```
 //!
 //! solved matrix-free by preconditioned conjugate gradients. Springs contribute S and C
 //! through their anchor points (anchor velocity = J u, J = [E, −[r]×]); drag contributes C.
 //! Forces without a Jacobian (applied forces, callbacks) stay explicit in f₀. The rotation
-//! is backward Euler too: q₊ = exp(h ω(q₊, L₊)/2) q, solved by fixed-point iteration.
+//! is backward Euler too: q₊ = exp(dt ω(q₊, L₊)/2) q, solved by fixed-point iteration.
 //! A spring compressed below its rest length has an indefinite transverse stiffness; its
 //! (1 − l₀/l) term is clamped at zero so the system stays definite (the usual remedy).
 
@@ -74,7 +74,7 @@ pub(super) fn step(
     sys: &mut System<'_>,
     motions: &mut [Motion],
     t: Real,
-    h: Real,
+    dt: Real,
     s: &mut Scratch,
 ) {
     let n = motions.len();
@@ -90,14 +90,14 @@ pub(super) fn step(
     for (u, m) in b.u0.iter_mut().zip(motions.iter()) {
         *u = Twist { lin: m.v, ang: m.w };
     }
-    // rhs = h f₀ − h² S u₀
+    // rhs = dt f₀ − dt² S u₀
     apply_springs(&b.springs, &b.u0, &mut b.rhs, true);
     for ((rhs, w), body) in b.rhs.iter_mut().zip(&s.wrench).zip(sys.bodies) {
-        rhs.lin = w.force * h - rhs.lin * (h * h);
-        rhs.ang = w.torque * h - rhs.ang * (h * h);
+        rhs.lin = w.force * dt - rhs.lin * (dt * dt);
+        rhs.ang = w.torque * dt - rhs.ang * (dt * dt);
         project(body, rhs);
     }
-    conjugate_gradient(sys.bodies, b, h);
+    conjugate_gradient(sys.bodies, b, dt);
     for (((m, du), body), inertia) in motions.iter_mut().zip(&b.x).zip(sys.bodies).zip(&b.inertia) {
         if body.kind != BodyKind::Dynamic {
             continue;
@@ -105,8 +105,8 @@ pub(super) fn step(
         let q0 = m.q;
         m.v += du.lin;
         m.l += *inertia * du.ang;
-        m.x += m.v * h;
-        m.q = implicit_rotation(body, q0, m.l, h);
+        m.x += m.v * dt;
+        m.q = implicit_rotation(body, q0, m.l, dt);
         refresh_omega(body, m);
     }
 }
@@ -209,11 +209,11 @@ fn project(body: &Body, t: &mut Twist) {
     }
 }
 
-/// out = (M + h C + h² S) u, projected.
+/// out = (M + dt C + dt² S) u, projected.
 fn apply_system(
     bodies: &[Body],
     b: &Buffers,
-    h: Real,
+    dt: Real,
     u: &[Twist],
     out: &mut [Twist],
     tmp: &mut [Twist],
@@ -224,9 +224,9 @@ fn apply_system(
         let body = &bodies[i];
         let mut y = Twist {
             lin: u[i].lin * body.mass
-                + (b.drag[i] * u[i].lin + tmp[i].lin) * h
-                + out[i].lin * (h * h),
-            ang: b.inertia[i] * u[i].ang + tmp[i].ang * h + out[i].ang * (h * h),
+                + (b.drag[i] * u[i].lin + tmp[i].lin) * dt
+                + out[i].lin * (dt * dt),
+            ang: b.inertia[i] * u[i].ang + tmp[i].ang * dt + out[i].ang * (dt * dt),
         };
         project(body, &mut y);
         out[i] = y;
@@ -235,7 +235,7 @@ fn apply_system(
 
 /// Solves for Δu into `b.x`, preconditioned by the inverse mass and inertia.
 #[allow(clippy::needless_range_loop)] // the CG updates read best as the textbook's loops
-fn conjugate_gradient(bodies: &[Body], b: &mut Buffers, h: Real) {
+fn conjugate_gradient(bodies: &[Body], b: &mut Buffers, dt: Real) {
     let norm_b: Real = b.rhs.iter().map(|t| t.dot(*t)).sum::<Real>().sqrt();
     if norm_b == 0.0 {
         return;
@@ -258,7 +258,7 @@ fn conjugate_gradient(bodies: &[Body], b: &mut Buffers, h: Real) {
     let tolerance = 1e3 * EPSILON * norm_b;
     let (mut ap, mut cu) = (std::mem::take(&mut b.ap), std::mem::take(&mut b.cu));
     for _ in 0..(6 * n + 20).min(1000) {
-        apply_system(bodies, b, h, &b.p, &mut ap, &mut cu);
+        apply_system(bodies, b, dt, &b.p, &mut ap, &mut cu);
         let pap = dot(&b.p, &ap);
         if pap <= 0.0 {
             break;
@@ -288,13 +288,13 @@ fn dot(a: &[Twist], b: &[Twist]) -> Real {
     a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum()
 }
 
-/// q₊ = exp(h ω(q₊, L₊)/2) q by fixed-point iteration; it contracts for h|ω| below about
+/// q₊ = exp(dt ω(q₊, L₊)/2) q by fixed-point iteration; it contracts for dt|ω| below about
 /// one radian per step and is stopped after a bounded number of sweeps otherwise.
-fn implicit_rotation(body: &Body, q0: crate::math::Quat, l: Vec3, h: Real) -> crate::math::Quat {
+fn implicit_rotation(body: &Body, q0: crate::math::Quat, l: Vec3, dt: Real) -> crate::math::Quat {
     let mut q = q0;
     for _ in 0..50 {
         let w = body.omega_from_momentum(q, l);
-        let next = (quat_from_rotation_vector(w * h) * q0).normalize();
+        let next = (quat_from_rotation_vector(w * dt) * q0).normalize();
         let change = (next - q).length();
         q = next;
         if change <= 4.0 * EPSILON {

@@ -42,7 +42,7 @@ pub enum Integrator {
     Midpoint,
     /// Classic fourth-order Runge–Kutta. Order 4.
     Rk4,
-    /// Störmer–Verlet on positions: x₊ = 2x − x₋ + a h². Order 2, symplectic.
+    /// Störmer–Verlet on positions: x₊ = 2x − x₋ + a dt². Order 2, symplectic.
     Verlet,
     /// Velocity Verlet (kick–drift–kick). Order 2, symplectic.
     VelocityVerlet,

@@ -1,7 +1,7 @@
 //! Rotational drifts: how q moves over a step once the angular momentum is fixed.
 //!
 //! A torque-free body conserves L (world) and its energy ½ Πᵀ I⁻¹ Π (Π = body-frame L).
-//! The plain update q += ½ h ω q keeps neither: it leaves the unit sphere and, renormalised,
+//! The plain update q += ½ dt ω q keeps neither: it leaves the unit sphere and, renormalised,
 //! pumps energy in, which at game steps ends with a box spinning about the wrong axis.
 //!
 //! Instead the drift splits the free-body Hamiltonian H = Σᵢ Πᵢ² / 2Iᵢ into its three
@@ -13,27 +13,27 @@
 use crate::body::{Body, BodyKind};
 use crate::math::{quat_from_rotation_vector, Quat, Real, Vec3};
 
-/// Orientation after a step `h` of a body whose angular momentum stays `l` over it
+/// Orientation after a step `dt` of a body whose angular momentum stays `l` over it
 /// (`w` is used for kinematic bodies, whose spin is prescribed).
-pub(crate) fn drift(body: &Body, q: Quat, l: Vec3, w: Vec3, h: Real) -> Quat {
+pub(crate) fn drift(body: &Body, q: Quat, l: Vec3, w: Vec3, dt: Real) -> Quat {
     match body.kind {
         BodyKind::Static => q,
-        BodyKind::Kinematic => exact_spin(w, q, h),
+        BodyKind::Kinematic => exact_spin(w, q, dt),
         BodyKind::Dynamic if body.planar => {
-            // The seed's 2D rule: θ₊ = θ + h L_z / I_zz about world z.
-            exact_spin(Vec3::new(0.0, 0.0, l.z / body.planar_inertia), q, h)
+            // The seed's 2D rule: θ₊ = θ + dt L_z / I_zz about world z.
+            exact_spin(Vec3::new(0.0, 0.0, l.z / body.planar_inertia), q, dt)
         }
         // A ball-like body (all principal moments equal) keeps ω = L/I constant while
         // torque-free: one exact rotation, where the splitting would take five.
-        BodyKind::Dynamic if body.isotropic => exact_spin(l / body.principal_moments.x, q, h),
-        BodyKind::Dynamic => free_rotor(body, q, l, h),
+        BodyKind::Dynamic if body.isotropic => exact_spin(l / body.principal_moments.x, q, dt),
+        BodyKind::Dynamic => free_rotor(body, q, l, dt),
     }
 }
 
-/// Rotation at a constant world angular velocity `w` for `h`: q₊ = exp(h w / 2) q.
+/// Rotation at a constant world angular velocity `w` for `dt`: q₊ = exp(dt w / 2) q.
 #[inline]
-pub(crate) fn exact_spin(w: Vec3, q: Quat, h: Real) -> Quat {
-    (quat_from_rotation_vector(w * h) * q).normalize()
+pub(crate) fn exact_spin(w: Vec3, q: Quat, dt: Real) -> Quat {
+    (quat_from_rotation_vector(w * dt) * q).normalize()
 }
 
 /// The symmetric principal-axis splitting of the torque-free rotor.
@@ -41,7 +41,7 @@ pub(crate) fn exact_spin(w: Vec3, q: Quat, h: Real) -> Quat {
 /// Works in the principal frame, where each sub-flow is a rotation about a coordinate
 /// axis: Π (body-frame L) turns backwards by the angle while the body turns forwards, so
 /// one sin/cos pair per sub-flow serves both and no quaternion rotates a vector in the loop.
-fn free_rotor(body: &Body, q: Quat, l: Vec3, h: Real) -> Quat {
+fn free_rotor(body: &Body, q: Quat, l: Vec3, dt: Real) -> Quat {
     let to_principal = body.principal_rotation;
     let mut pi = (q * to_principal).inverse() * l;
     let inv = body.principal_moments.recip();
@@ -49,7 +49,7 @@ fn free_rotor(body: &Body, q: Quat, l: Vec3, h: Real) -> Quat {
     let mut acc = [0.0 as Real, 0.0, 0.0, 1.0];
     for (axis, fraction) in [(0usize, 0.5), (1, 0.5), (2, 1.0), (1, 0.5), (0, 0.5)] {
         let rate = [pi.x * inv.x, pi.y * inv.y, pi.z * inv.z][axis];
-        let (s, c) = (0.5 * fraction * h * rate).sin_cos();
+        let (s, c) = (0.5 * fraction * dt * rate).sin_cos();
         // Turning the body by +θ about e_axis turns Π by −θ: cos θ = c² − s², sin θ = 2sc.
         let (cos, sin) = (c * c - s * s, 2.0 * s * c);
         pi = match axis {
