@@ -20,6 +20,9 @@
 //! boxes, at the cost of the changed proxies plus one pass over the pair list.
 //!
 //! Determinism: pairs live in a sorted `Vec`, trees in index pools; no hashing anywhere.
+//!
+//! Layout: this file holds the proxies, their updates and the pair set; `tree.rs` the
+//! dynamic tree; `query.rs` the box and ray queries; `tests.rs` the tests.
 
 mod query;
 #[cfg(test)]

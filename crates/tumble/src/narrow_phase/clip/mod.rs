@@ -14,6 +14,10 @@
 //! face, an incident edge crossing a reference side, a reference corner inside the incident
 //! face), numbered by the shapes' own vertex and face indices, so a resting contact keeps
 //! its ids from step to step.
+//!
+//! Layout: this file holds the features, their clipping and the selection of contact
+//! points; `polytope.rs` the shape cores as polytopes the features come from; `tests.rs`
+//! the tests.
 
 mod polytope;
 #[cfg(test)]

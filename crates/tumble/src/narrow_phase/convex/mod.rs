@@ -27,6 +27,9 @@
 //!
 //! Mixed pairs are always computed in one order (by kind) and flipped if asked the other
 //! way, so swapping the pair flips the normal exactly.
+//!
+//! Layout: this file holds the dispatch, the GJK/EPA path and the public closest-points
+//! queries; `sat.rs` the separating-axis test of polytope pairs; `tests.rs` the tests.
 
 mod sat;
 #[cfg(test)]

@@ -17,6 +17,9 @@
 //! are edges 1 and 2 (the low and high ends of the overlap along A's axis) on both; the ends
 //! of a capsule clipped on a box face are its vertices, or edges 2 and 3 where the face's
 //! sides cut it. Box features are numbered as in `box_box.rs`.
+//!
+//! Layout: this file holds the shared segment helpers and the round–round pairs;
+//! `boxes.rs` spheres and capsules against boxes; `tests.rs` the tests.
 
 mod boxes;
 #[cfg(test)]

@@ -8,6 +8,11 @@
 //! do not end up in the hull. Coplanar triangles are then grouped into polygonal faces (for
 //! collision detection), and any vertex that turns out to sit inside such a face or on an edge
 //! between two of them is removed by rebuilding from the true corners.
+//!
+//! Layout: this file holds the public [`ConvexHull`], input validation and the normalised
+//! frame with its tolerances; `build.rs` the quickhull construction, `exact.rs` the exact
+//! predicates, `faces.rs` the polygonal faces and the assembly of the result, `mass.rs` the
+//! mass properties, `tests.rs` the tests.
 
 mod build;
 mod exact;

@@ -10,6 +10,10 @@
 //! bend angle: how far the neighbour's face turns away (convex, > 0) or towards (concave,
 //! < 0) this triangle's front side. The narrow phase uses it to reject contact normals that
 //! come from internal edges a smooth surface does not have.
+//!
+//! Layout: this file holds the mesh, its queries and the triangle geometry they share with
+//! height fields; `build.rs` the one-time adjacency and hierarchy builds; `tests.rs` the
+//! tests.
 
 mod build;
 #[cfg(test)]
