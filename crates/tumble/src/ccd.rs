@@ -119,14 +119,6 @@ pub(crate) fn shape_toi(
     slop: Real,
     limit: Real,
 ) -> Real {
-    let child_sweep = |s: &Sweep, position: Vec3, orientation: Quat| {
-        let child = s.start.mul(&Pose::new(position, orientation));
-        Sweep {
-            start: child,
-            local_center: Pose::new(position, orientation).inverse_transform_point(s.local_center),
-            ..*s
-        }
-    };
     match (a, b) {
         (Shape::Compound(children), _) => children
             .iter()
@@ -154,44 +146,68 @@ pub(crate) fn shape_toi(
                 )
             })
             .fold(limit, Real::min),
-        (_, Shape::Plane { normal, offset }) => match Convex::from_shape(a) {
-            Some(ca) => plane_toi(
-                &ca,
-                sa,
-                sb.start.transform_vector(*normal),
-                sb.start.position,
-                *offset,
-                slop,
-            )
-            .min(limit),
-            None => limit,
-        },
-        (_, Shape::TriMesh(mesh)) => match Convex::from_shape(a) {
-            Some(ca) => {
-                let mut t = limit;
-                let region = local_region(a, sa, &sb.start);
-                mesh.for_each_triangle_in(&region, |k| {
-                    t = t.min(toi(&ca, sa, &Convex::Triangle(mesh.triangle(k)), sb, slop));
-                });
-                t
+        (_, Shape::Plane { .. } | Shape::TriMesh(_) | Shape::HeightField(_)) => {
+            match Convex::from_shape(a) {
+                Some(ca) => static_toi(&ca, a, sa, b, sb, slop, limit),
+                None => limit,
             }
-            None => limit,
-        },
-        (_, Shape::HeightField(field)) => match Convex::from_shape(a) {
-            Some(ca) => {
-                let mut t = limit;
-                let region = local_region(a, sa, &sb.start);
-                field.for_each_triangle_in(&region, |_, tri| {
-                    t = t.min(toi(&ca, sa, &Convex::Triangle(tri), sb, slop));
-                });
-                t
-            }
-            None => limit,
-        },
+        }
         _ => match (Convex::from_shape(a), Convex::from_shape(b)) {
             (Some(ca), Some(cb)) => toi(&ca, sa, &cb, sb, slop).min(limit),
             _ => limit,
         },
+    }
+}
+
+/// The sweep of a compound's child at `position`, `orientation` in the compound's frame.
+fn child_sweep(s: &Sweep, position: Vec3, orientation: Quat) -> Sweep {
+    let child = s.start.mul(&Pose::new(position, orientation));
+    Sweep {
+        start: child,
+        local_center: Pose::new(position, orientation).inverse_transform_point(s.local_center),
+        ..*s
+    }
+}
+
+/// Earliest impact of the convex `ca` (of shape `a`) against a resting plane, mesh or height
+/// field `b`, or `limit`; a mesh or field is searched only over the triangles the sweep's
+/// region overlaps.
+fn static_toi(
+    ca: &Convex,
+    a: &Shape,
+    sa: &Sweep,
+    b: &Shape,
+    sb: &Sweep,
+    slop: Real,
+    limit: Real,
+) -> Real {
+    match b {
+        Shape::Plane { normal, offset } => plane_toi(
+            ca,
+            sa,
+            sb.start.transform_vector(*normal),
+            sb.start.position,
+            *offset,
+            slop,
+        )
+        .min(limit),
+        Shape::TriMesh(mesh) => {
+            let mut t = limit;
+            let region = local_region(a, sa, &sb.start);
+            mesh.for_each_triangle_in(&region, |k| {
+                t = t.min(toi(ca, sa, &Convex::Triangle(mesh.triangle(k)), sb, slop));
+            });
+            t
+        }
+        Shape::HeightField(field) => {
+            let mut t = limit;
+            let region = local_region(a, sa, &sb.start);
+            field.for_each_triangle_in(&region, |_, tri| {
+                t = t.min(toi(ca, sa, &Convex::Triangle(tri), sb, slop));
+            });
+            t
+        }
+        _ => limit,
     }
 }
 

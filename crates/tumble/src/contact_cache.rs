@@ -192,6 +192,77 @@ fn apart(a: &Aabb, b: &Aabb, gap: Real) -> bool {
         || b.min.z - a.max.z > gap
 }
 
+/// Whether the pair at body indices `(a, b)` needs contacts at all: one of the two must be
+/// dynamic, and bodies a joint holds together do not collide unless it says so.
+fn may_collide(
+    body_a: &Body,
+    body_b: &Body,
+    (a, b): (usize, usize),
+    joined: &[(u32, u32)],
+) -> bool {
+    if body_a.kind != BodyKind::Dynamic && body_b.kind != BodyKind::Dynamic {
+        return false;
+    }
+    let key = (a.min(b) as u32, a.max(b) as u32);
+    joined.is_empty() || joined.binary_search(&key).is_err()
+}
+
+/// A body that cannot have moved since the last step: static, or dynamic and asleep.
+fn frozen(b: &Body) -> bool {
+    b.kind == BodyKind::Static || (b.kind == BodyKind::Dynamic && !b.awake)
+}
+
+/// Reuses last step's contact of the pair if their relative pose still holds it, placing it
+/// at the new poses; whether it did.
+fn reuse_previous(
+    old: &Sorted<'_>,
+    (a, b): (usize, usize),
+    ids: &[BodyId],
+    (pa, pb): (&Pose, &Pose),
+    margin: Real,
+    contacts: &mut Vec<Contact>,
+) -> bool {
+    let Some(c) = old.find((ids[a], ids[b], 0, 0)).filter(|c| {
+        c.basis
+            .holds(&Basis::relative(pa, pb), REUSE_DISTANCE * margin)
+    }) else {
+        return false;
+    };
+    // Updated in place: a contact is a kilobyte, and a copy on the stack
+    // before the push doubled what this costs.
+    contacts.push(*c);
+    let contact = contacts.last_mut().expect("just pushed");
+    (contact.index_a, contact.index_b) = (a as u32, b as u32);
+    contact.basis.place(&mut contact.manifold, pa, pb);
+    // Matches each point to itself, but re-anchors the ones that slid.
+    warm_start(contact, old, (pa, pb));
+    true
+}
+
+/// Pushes a contact for each of the pair's freshly computed manifolds, warm-started from
+/// last step's.
+fn push_new(
+    manifolds: &[Manifold],
+    old: &Sorted<'_>,
+    (a, b): (usize, usize),
+    ids: &[BodyId],
+    (pa, pb): (&Pose, &Pose),
+    contacts: &mut Vec<Contact>,
+) {
+    for manifold in manifolds {
+        contacts.push(Contact {
+            body_a: ids[a],
+            body_b: ids[b],
+            manifold: *manifold,
+            index_a: a as u32,
+            index_b: b as u32,
+            basis: Basis::of(manifold, pa, pb),
+        });
+        let contact = contacts.last_mut().expect("just pushed");
+        warm_start(contact, old, (pa, pb));
+    }
+}
+
 impl ContactCache {
     /// The contacts found by the last update, ordered by body pair.
     pub fn contacts(&self) -> &[Contact] {
@@ -225,18 +296,11 @@ impl ContactCache {
             let (Some(body_a), Some(body_b)) = (bodies.get(a), bodies.get(b)) else {
                 continue;
             };
-            if body_a.kind != BodyKind::Dynamic && body_b.kind != BodyKind::Dynamic {
-                continue;
-            }
-            // Bodies a joint holds together do not collide unless it says so.
-            let key = (a.min(b) as u32, a.max(b) as u32);
-            if !joined.is_empty() && joined.binary_search(&key).is_ok() {
+            if !may_collide(body_a, body_b, (a, b), joined) {
                 continue;
             }
             // A sleeping island costs nothing: between bodies that cannot have moved, last
             // step's manifolds still hold.
-            let frozen =
-                |b: &Body| b.kind == BodyKind::Static || (b.kind == BodyKind::Dynamic && !b.awake);
             if frozen(body_a) && frozen(body_b) {
                 keep_previous(&old, ids[a], ids[b], a, b, &mut self.contacts);
                 continue;
@@ -253,21 +317,12 @@ impl ContactCache {
                 continue;
             }
             let (pa, pb) = (body_a.pose(), body_b.pose());
-            if reusable(&body_a.shape) && reusable(&body_b.shape) {
-                if let Some(c) = old.find((ids[a], ids[b], 0, 0)).filter(|c| {
-                    c.basis
-                        .holds(&Basis::relative(&pa, &pb), REUSE_DISTANCE * margin)
-                }) {
-                    // Updated in place: a contact is a kilobyte, and a copy on the stack
-                    // before the push doubled what this costs.
-                    self.contacts.push(*c);
-                    let contact = self.contacts.last_mut().expect("just pushed");
-                    (contact.index_a, contact.index_b) = (a as u32, b as u32);
-                    contact.basis.place(&mut contact.manifold, &pa, &pb);
-                    // Matches each point to itself, but re-anchors the ones that slid.
-                    warm_start(contact, &old, (&pa, &pb));
-                    continue;
-                }
+            let poses = (&pa, &pb);
+            if reusable(&body_a.shape)
+                && reusable(&body_b.shape)
+                && reuse_previous(&old, (a, b), ids, poses, margin, &mut self.contacts)
+            {
+                continue;
             }
             self.manifolds.clear();
             collide(
@@ -285,18 +340,14 @@ impl ContactCache {
                 }
                 self.manifolds.retain(|m| !m.is_empty());
             }
-            for manifold in &self.manifolds {
-                self.contacts.push(Contact {
-                    body_a: ids[a],
-                    body_b: ids[b],
-                    manifold: *manifold,
-                    index_a: a as u32,
-                    index_b: b as u32,
-                    basis: Basis::of(manifold, &pa, &pb),
-                });
-                let contact = self.contacts.last_mut().expect("just pushed");
-                warm_start(contact, &old, (&pa, &pb));
-            }
+            push_new(
+                &self.manifolds,
+                &old,
+                (a, b),
+                ids,
+                poses,
+                &mut self.contacts,
+            );
         }
         self.find_events();
     }

@@ -336,48 +336,8 @@ fn face_contact(
 ) -> bool {
     let (k, positive) = face;
     let sk = if positive { 1.0 } else { -1.0 };
-    // The incident box in the reference frame.
-    let axes = axes_in(rf.pose, inc.pose);
-    let centre = rf.pose.inverse_transform_point(inc.pose.position);
-
-    // Incident face: the axis most parallel to the reference normal sk·e_k, on the side
-    // whose outward normal opposes it (axis·(sk e_k) < 0 → the +h face).
-    let mut j = 0;
-    for m in 1..3 {
-        if axes[m][k].abs() > axes[j][k].abs() {
-            j = m;
-        }
-    }
-    let inc_positive = axes[j][k] * sk < 0.0;
-    let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
-    let mut poly = Polygon::default();
-    // Around the face: (+,+), (−,+), (−,−), (+,−) in (j1, j2); consecutive corners differ
-    // in one sign, along j1 then j2 alternately, which names the edge between them.
-    let corners = [(true, true), (false, true), (false, false), (true, false)];
-    for (m, &(s1, s2)) in corners.iter().enumerate() {
-        let mut signs = [false; 3];
-        signs[j] = inc_positive;
-        signs[j1] = s1;
-        signs[j2] = s2;
-        let local = vertex(inc.he, signs);
-        let along = if m % 2 == 0 { j1 } else { j2 };
-        poly.push(ClipVertex {
-            p: centre + axes[0] * local.x + axes[1] * local.y + axes[2] * local.z,
-            kind: VERTEX,
-            index: vertex_index(signs),
-            edge: edge_index(along, signs),
-        });
-    }
-
-    // The side planes of the reference face: s·x_a ≤ h_a for the two other axes a.
-    let mut spare = Polygon::default();
-    for plane in 0..4u32 {
-        let a = if plane < 2 { (k + 1) % 3 } else { (k + 2) % 3 };
-        let s = if plane % 2 == 0 { 1.0 } else { -1.0 };
-        let h = rf.he[a];
-        poly.clip(|p| s * p[a] - h, plane, &mut spare);
-        std::mem::swap(&mut poly, &mut spare);
-    }
+    let mut poly = incident_face(&rf, &inc, k, sk);
+    clip_to_side_planes(&mut poly, &rf, k);
 
     // Keep what lies below the reference face + margin: depth = sk·x_k − h_k is the signed
     // height above the face plane, i.e. the separation, since the point on the reference
@@ -417,6 +377,57 @@ fn face_contact(
     out.normal = if ref_is_a { normal } else { -normal };
     reduce(&cands[..n], margin, out);
     !out.is_empty()
+}
+
+/// The incident box's face most anti-parallel to the reference normal sk·e_k, in the
+/// reference box's frame, its corners tagged with their vertex and edge ids.
+fn incident_face(rf: &Solid, inc: &Solid, k: usize, sk: Real) -> Polygon {
+    // The incident box in the reference frame.
+    let axes = axes_in(rf.pose, inc.pose);
+    let centre = rf.pose.inverse_transform_point(inc.pose.position);
+
+    // Incident face: the axis most parallel to the reference normal sk·e_k, on the side
+    // whose outward normal opposes it (axis·(sk e_k) < 0 → the +h face).
+    let mut j = 0;
+    for m in 1..3 {
+        if axes[m][k].abs() > axes[j][k].abs() {
+            j = m;
+        }
+    }
+    let inc_positive = axes[j][k] * sk < 0.0;
+    let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
+    let mut poly = Polygon::default();
+    // Around the face: (+,+), (−,+), (−,−), (+,−) in (j1, j2); consecutive corners differ
+    // in one sign, along j1 then j2 alternately, which names the edge between them.
+    let corners = [(true, true), (false, true), (false, false), (true, false)];
+    for (m, &(s1, s2)) in corners.iter().enumerate() {
+        let mut signs = [false; 3];
+        signs[j] = inc_positive;
+        signs[j1] = s1;
+        signs[j2] = s2;
+        let local = vertex(inc.he, signs);
+        let along = if m % 2 == 0 { j1 } else { j2 };
+        poly.push(ClipVertex {
+            p: centre + axes[0] * local.x + axes[1] * local.y + axes[2] * local.z,
+            kind: VERTEX,
+            index: vertex_index(signs),
+            edge: edge_index(along, signs),
+        });
+    }
+    poly
+}
+
+/// Clips `poly` to the side planes of the reference face on axis `k`: s·x_a ≤ h_a for the
+/// two other axes a.
+fn clip_to_side_planes(poly: &mut Polygon, rf: &Solid, k: usize) {
+    let mut spare = Polygon::default();
+    for plane in 0..4u32 {
+        let a = if plane < 2 { (k + 1) % 3 } else { (k + 2) % 3 };
+        let s = if plane % 2 == 0 { 1.0 } else { -1.0 };
+        let h = rf.he[a];
+        poly.clip(|p| s * p[a] - h, plane, &mut spare);
+        std::mem::swap(poly, &mut spare);
+    }
 }
 
 /// The two edge directions of an edge–edge axis, with B's axes and centre in A's frame.

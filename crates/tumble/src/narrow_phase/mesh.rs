@@ -34,7 +34,7 @@
 use super::{convex_pair, feature_id, reduce, Candidate, ContactPoint, Manifold};
 use crate::geometry::{Aabb, Convex, Pose};
 use crate::math::{Real, Vec3, EPSILON};
-use crate::shape::{convex_aabb, HeightField, TriMesh};
+use crate::shape::{convex_aabb, ConvexHull, HeightField, TriMesh};
 
 /// Largest tilt (sine of the angle) of a normal from the face normal that is taken for
 /// rounding in the convex routine rather than an edge contact.
@@ -356,109 +356,121 @@ type Tagged = (Vec3, u32);
 /// cyclic polygon (one or two points for a vertex or segment), world frame.
 fn incident_feature(a: &Convex, pa: &Pose, dir: Vec3) -> Vec<Tagged> {
     let d = pa.inverse_transform_vector(dir);
-    // Points of the convex's frame to world, numbered by their order in the feature
-    // unless they carry their own vertex index.
-    let world = |pts: Vec<Vec3>| -> Vec<Tagged> {
-        pts.into_iter()
-            .enumerate()
-            .map(|(i, p)| (pa.transform_point(p), feature_id(0, i as u32, 2, 0)))
-            .collect()
-    };
     match a {
-        Convex::Box { half_extents: h } => {
-            let ax = if d.x.abs() >= d.y.abs() && d.x.abs() >= d.z.abs() {
-                0
-            } else if d.y.abs() >= d.z.abs() {
-                1
-            } else {
-                2
-            };
-            let (b, c) = ((ax + 1) % 3, (ax + 2) % 3);
-            let s = if d[ax] < 0.0 { -1.0 } else { 1.0 };
-            let corner = |u: Real, v: Real| {
-                let mut p = Vec3::ZERO;
-                p[ax] = s * h[ax];
-                p[b] = u * h[b];
-                p[c] = v * h[c];
-                p
-            };
-            world(vec![
-                corner(-1.0, -1.0),
-                corner(1.0, -1.0),
-                corner(1.0, 1.0),
-                corner(-1.0, 1.0),
-            ])
-        }
+        Convex::Box { half_extents: h } => to_world(pa, box_face(*h, d)),
         Convex::Hull(hull) => {
-            // The face whose normal is most nearly along d (the first on ties).
-            let mut best: Option<(usize, Real)> = None;
-            for (i, (n, _)) in hull.face_planes().iter().enumerate() {
-                let score = n.dot(d);
-                if best.is_none_or(|(_, s)| score > s) {
-                    best = Some((i, score));
-                }
-            }
-            let Some((f, _)) = best else {
-                return world(vec![a.support(d)]);
-            };
-            let v = hull.vertices();
-            hull.face_vertices(f)
-                .iter()
-                .filter_map(|&k| {
-                    v.get(k as usize)
-                        .map(|&p| (pa.transform_point(p), feature_id(0, k, 2, 0)))
-                })
-                .collect()
+            hull_face(hull, pa, d).unwrap_or_else(|| to_world(pa, vec![a.support(d)]))
         }
         Convex::Capsule {
             radius,
             half_height,
-        } => {
-            let off = d.normalize_or_zero() * *radius;
-            let top = Vec3::new(0.0, *half_height, 0.0);
-            if *half_height > 0.0 {
-                world(vec![top + off, -top + off])
-            } else {
-                world(vec![off])
-            }
-        }
+        } => to_world(pa, capsule_feature(*radius, *half_height, d)),
         Convex::Cylinder {
             radius,
             half_height,
-        } => {
-            let radial = Vec3::new(d.x, 0.0, d.z).normalize_or_zero();
-            let u = if radial == Vec3::ZERO {
-                Vec3::X
-            } else {
-                radial
-            };
-            let cap = if d.y < 0.0 {
-                -*half_height
-            } else {
-                *half_height
-            };
-            if d.y.abs() >= std::f64::consts::FRAC_1_SQRT_2 as Real * d.length() {
-                // Facing mostly along the axis: the cap, as an octagon whose first corner
-                // is the exact support point (so a slightly tilted cylinder still reports
-                // its lowest point).
-                let w = Vec3::new(-u.z, 0.0, u.x);
-                let pts = (0..8)
-                    .map(|k| {
-                        let ang = k as Real * std::f64::consts::FRAC_PI_4 as Real;
-                        (u * ang.cos() + w * ang.sin()) * *radius + Vec3::new(0.0, cap, 0.0)
-                    })
-                    .collect();
-                world(pts)
-            } else {
-                let rim = u * *radius;
-                world(vec![
-                    rim + Vec3::new(0.0, *half_height, 0.0),
-                    rim - Vec3::new(0.0, *half_height, 0.0),
-                ])
-            }
+        } => to_world(pa, cylinder_feature(*radius, *half_height, d)),
+        Convex::Triangle(t) => to_world(pa, t.to_vec()),
+        Convex::Sphere { .. } => to_world(pa, vec![a.support(d)]),
+    }
+}
+
+/// Points of the convex's frame to world, numbered by their order in the feature (for
+/// features whose points carry no vertex index of their own).
+fn to_world(pa: &Pose, pts: Vec<Vec3>) -> Vec<Tagged> {
+    pts.into_iter()
+        .enumerate()
+        .map(|(i, p)| (pa.transform_point(p), feature_id(0, i as u32, 2, 0)))
+        .collect()
+}
+
+/// The box face most nearly along the local direction `d`: its four corners (local frame).
+fn box_face(h: Vec3, d: Vec3) -> Vec<Vec3> {
+    let ax = if d.x.abs() >= d.y.abs() && d.x.abs() >= d.z.abs() {
+        0
+    } else if d.y.abs() >= d.z.abs() {
+        1
+    } else {
+        2
+    };
+    let (b, c) = ((ax + 1) % 3, (ax + 2) % 3);
+    let s = if d[ax] < 0.0 { -1.0 } else { 1.0 };
+    let corner = |u: Real, v: Real| {
+        let mut p = Vec3::ZERO;
+        p[ax] = s * h[ax];
+        p[b] = u * h[b];
+        p[c] = v * h[c];
+        p
+    };
+    vec![
+        corner(-1.0, -1.0),
+        corner(1.0, -1.0),
+        corner(1.0, 1.0),
+        corner(-1.0, 1.0),
+    ]
+}
+
+/// The hull face whose normal is most nearly along the local direction `d` (the first on
+/// ties), world frame, numbered by the hull's vertex indices; `None` for a hull without faces.
+fn hull_face(hull: &ConvexHull, pa: &Pose, d: Vec3) -> Option<Vec<Tagged>> {
+    let mut best: Option<(usize, Real)> = None;
+    for (i, (n, _)) in hull.face_planes().iter().enumerate() {
+        let score = n.dot(d);
+        if best.is_none_or(|(_, s)| score > s) {
+            best = Some((i, score));
         }
-        Convex::Triangle(t) => world(t.to_vec()),
-        Convex::Sphere { .. } => world(vec![a.support(d)]),
+    }
+    let (f, _) = best?;
+    let v = hull.vertices();
+    Some(
+        hull.face_vertices(f)
+            .iter()
+            .filter_map(|&k| {
+                v.get(k as usize)
+                    .map(|&p| (pa.transform_point(p), feature_id(0, k, 2, 0)))
+            })
+            .collect(),
+    )
+}
+
+/// A capsule's facing feature (local frame): its shaft offset by the radius towards `d`, or
+/// one point if it has no shaft.
+fn capsule_feature(radius: Real, half_height: Real, d: Vec3) -> Vec<Vec3> {
+    let off = d.normalize_or_zero() * radius;
+    let top = Vec3::new(0.0, half_height, 0.0);
+    if half_height > 0.0 {
+        vec![top + off, -top + off]
+    } else {
+        vec![off]
+    }
+}
+
+/// A cylinder's facing feature (local frame): its cap when `d` runs mostly along the axis,
+/// otherwise the side line towards `d`.
+fn cylinder_feature(radius: Real, half_height: Real, d: Vec3) -> Vec<Vec3> {
+    let radial = Vec3::new(d.x, 0.0, d.z).normalize_or_zero();
+    let u = if radial == Vec3::ZERO {
+        Vec3::X
+    } else {
+        radial
+    };
+    let cap = if d.y < 0.0 { -half_height } else { half_height };
+    if d.y.abs() >= std::f64::consts::FRAC_1_SQRT_2 as Real * d.length() {
+        // Facing mostly along the axis: the cap, as an octagon whose first corner
+        // is the exact support point (so a slightly tilted cylinder still reports
+        // its lowest point).
+        let w = Vec3::new(-u.z, 0.0, u.x);
+        (0..8)
+            .map(|k| {
+                let ang = k as Real * std::f64::consts::FRAC_PI_4 as Real;
+                (u * ang.cos() + w * ang.sin()) * radius + Vec3::new(0.0, cap, 0.0)
+            })
+            .collect()
+    } else {
+        let rim = u * radius;
+        vec![
+            rim + Vec3::new(0.0, half_height, 0.0),
+            rim - Vec3::new(0.0, half_height, 0.0),
+        ]
     }
 }
 
