@@ -6,6 +6,7 @@ use crate::contact_cache::{Contact, ContactCache, ContactEvent};
 use crate::diagnostics::{self, Diagnostics};
 use crate::error::{check, Error, Result};
 use crate::force::{Force, ForceCallback};
+use crate::handles::Handles;
 use crate::id::{BodyId, ForceId};
 use crate::integrate::{self, Integrator, Motion, Scratch, System, VerletMemory};
 use crate::joint::{Joint, JointId};
@@ -116,8 +117,7 @@ pub struct World {
     contacts: ContactCache,
     /// Joints in creation order, with their handles (see `world_joints.rs`).
     pub(crate) joints: Vec<Joint>,
-    pub(crate) joint_ids: Vec<JointId>,
-    pub(crate) next_joint_id: u32,
+    pub(crate) joint_handles: Handles<JointId>,
     /// Each joint's bodies as dense indices, refreshed every step.
     pub(crate) joint_bodies: Vec<[Option<usize>; 2]>,
     /// Dense body pairs a joint keeps from colliding, sorted, refreshed every step.
@@ -175,8 +175,7 @@ impl World {
             proxy_updates: Vec::new(),
             contacts: ContactCache::default(),
             joints: Vec::new(),
-            joint_ids: Vec::new(),
-            next_joint_id: 0,
+            joint_handles: Handles::default(),
             joint_bodies: Vec::new(),
             joined_pairs: Vec::new(),
         }

@@ -37,10 +37,8 @@ impl World {
             (p.position, p.rotation)
         };
         let joint = joint::build(def, pose(a), b.map(pose));
-        let id = JointId(self.next_joint_id);
-        self.next_joint_id += 1;
+        let id = self.joint_handles.insert();
         self.joints.push(joint);
-        self.joint_ids.push(id);
         self.wake_around(a);
         if let Some(b) = b {
             self.wake_around(b);
@@ -49,13 +47,11 @@ impl World {
         Ok(id)
     }
 
-    /// Removes a joint, waking the bodies it held; false if there is no such joint.
-    pub fn remove_joint(&mut self, id: JointId) -> bool {
-        let Some(k) = self.joint_ids.iter().position(|j| *j == id) else {
-            return false;
-        };
+    /// Removes a joint, waking the bodies it held. Fails, changing nothing, on an unknown
+    /// or stale handle (`joint: unknown or removed joint ...`), as `remove_body` does.
+    pub fn remove_joint(&mut self, id: JointId) -> Result<()> {
+        let k = self.joint_handles.remove(id).ok_or_else(|| unknown(id))?;
         let joint = self.joints.remove(k);
-        self.joint_ids.remove(k);
         for body in [Some(joint.def.body), joint.def.other]
             .into_iter()
             .flatten()
@@ -65,16 +61,15 @@ impl World {
             }
         }
         self.refresh_joint_links();
-        true
+        Ok(())
     }
 
-    /// The joint with handle `id`.
+    /// The joint with handle `id`; an error for an unknown or stale handle.
     pub fn joint(&self, id: JointId) -> Result<&Joint> {
-        self.joint_ids
-            .iter()
-            .position(|j| *j == id)
+        self.joint_handles
+            .dense(id)
             .map(|k| &self.joints[k])
-            .ok_or_else(|| Error::invalid("joint", format!("unknown or removed joint {id:?}")))
+            .ok_or_else(|| unknown(id))
     }
 
     /// The handle of the joint called `name`.
@@ -82,12 +77,16 @@ impl World {
         self.joints
             .iter()
             .position(|j| j.def.name.as_deref() == Some(name))
-            .map(|k| self.joint_ids[k])
+            .map(|k| self.joint_handles.ids()[k])
     }
 
     /// All joints with their handles, in creation order.
     pub fn joints(&self) -> impl Iterator<Item = (JointId, &Joint)> {
-        self.joint_ids.iter().copied().zip(self.joints.iter())
+        self.joint_handles
+            .ids()
+            .iter()
+            .copied()
+            .zip(self.joints.iter())
     }
 
     /// Removes every joint attached to `body` (the body is being removed).
@@ -98,7 +97,8 @@ impl World {
             .map(|(id, _)| id)
             .collect();
         for id in attached {
-            self.remove_joint(id);
+            // Just listed, so live: removal cannot fail.
+            let _ = self.remove_joint(id);
         }
     }
 
@@ -131,4 +131,9 @@ impl World {
         self.joined_pairs.dedup();
         self.joint_bodies = links;
     }
+}
+
+/// The error for a handle naming no live joint.
+fn unknown(id: JointId) -> Error {
+    Error::invalid("joint", format!("unknown or removed joint {id:?}"))
 }
