@@ -4,7 +4,9 @@
 use numpy::PyArray1;
 use pyo3::exceptions::{PyKeyError, PyTypeError};
 use pyo3::prelude::*;
-use tumble::{BodyId, JointDef, JointId, JointKind, Quat, Real, Vec3};
+use pyo3::types::PyDict;
+use tumble::joint::{JointOption, JointOptions, KindSpec, OptionShape, OptionValue};
+use tumble::{BodyId, JointDef, JointId, JointKind, Quat, Vec3};
 
 use crate::body::{handle, PyBody};
 use crate::convert::{engine, invalid, numbers, real, vec3, vec3_out, wrong_type};
@@ -144,13 +146,13 @@ impl PyJoint {
     }
 
     fn __hash__(&self) -> u64 {
-        u64::from(self.id.0)
+        (u64::from(self.id.generation) << 32) | u64::from(self.id.index)
     }
 
     fn __repr__(&self) -> String {
         match self.read(|j| (j.kind().name(), j.name().map(str::to_string))) {
             Ok((kind, Some(name))) => format!("<tumble.Joint {kind} '{name}'>"),
-            Ok((kind, None)) => format!("<tumble.Joint {kind} #{}>", self.id.0),
+            Ok((kind, None)) => format!("<tumble.Joint {kind} #{}>", self.id.index),
             Err(_) => "<tumble.Joint (removed)>".into(),
         }
     }
@@ -166,115 +168,113 @@ fn joint_handle<'py>(world: &Bound<'py, PyWorld>, id: JointId) -> PyResult<Bound
     )
 }
 
-/// The kind-specific options; `None` where not given.
-#[derive(Default)]
-struct Options<'a, 'py> {
-    cone: Option<f64>,
-    twist: Option<&'a Bound<'py, PyAny>>,
-    limits: Option<&'a Bound<'py, PyAny>>,
-    motor: Option<&'a Bound<'py, PyAny>>,
-    spring: Option<&'a Bound<'py, PyAny>>,
-    length: Option<f64>,
-    min: Option<f64>,
-    max: Option<f64>,
-}
-
-fn range(obj: Option<&Bound<'_, PyAny>>, field: &str) -> PyResult<Option<[Real; 2]>> {
-    obj.map(|o| {
-        let v = numbers(o, field, 2, "[lower, upper]")?;
-        Ok([real(v[0]), real(v[1])])
-    })
-    .transpose()
-}
-
-fn motor(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<tumble::Motor>> {
-    obj.map(|o| {
-        let m = o
-            .cast::<PyMotor>()
-            .map_err(|_| wrong_type("motor", "a tumble.Motor(speed, max_force)", o))?;
-        let m = m.get();
-        Ok(tumble::Motor {
-            speed: real(m.speed),
-            max_force: real(m.max_force),
-        })
-    })
-    .transpose()
-}
-
-fn spring(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<tumble::JointSpring>> {
-    obj.map(|o| {
-        let s = o
-            .cast::<PyJointSpring>()
-            .map_err(|_| wrong_type("spring", "a tumble.JointSpring(hertz, ...)", o))?;
-        let s = s.get();
-        Ok(tumble::JointSpring {
-            hertz: real(s.hertz),
-            damping_ratio: real(s.damping_ratio),
-            target: real(s.target),
-        })
-    })
-    .transpose()
-}
-
-fn kind_of(name: &str, o: &Options<'_, '_>) -> PyResult<JointKind> {
-    let given = [
-        ("cone", o.cone.is_some()),
-        ("twist", o.twist.is_some()),
-        ("limits", o.limits.is_some()),
-        ("motor", o.motor.is_some()),
-        ("spring", o.spring.is_some()),
-        ("length", o.length.is_some()),
-        ("min", o.min.is_some()),
-        ("max", o.max.is_some()),
-    ];
-    let allowed: &[&str] = match name {
-        "ball" => &["cone", "twist"],
-        "hinge" | "slider" => &["limits", "motor", "spring"],
-        "fixed" => &[],
-        "distance" => &["length", "min", "max", "spring"],
-        other => {
-            return Err(invalid(
-                "kind",
-                format!(
-                    "unknown joint type '{other}' (expected one of: {})",
-                    tumble_scene::JOINT_TYPES.join(", ")
-                ),
-            ))
-        }
+/// The option `key` of a joint, if given and not None.
+fn given<'py>(
+    options: Option<&Bound<'py, PyDict>>,
+    key: &str,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let Some(options) = options else {
+        return Ok(None);
     };
-    if let Some((key, _)) = given.iter().find(|(k, g)| *g && !allowed.contains(k)) {
-        return Err(PyTypeError::new_err(format!(
-            "{key}: not an option of a {name} joint (its options: {})",
-            if allowed.is_empty() {
-                "none".to_string()
-            } else {
-                allowed.join(", ")
-            }
-        )));
+    Ok(options.get_item(key)?.filter(|v| !v.is_none()))
+}
+
+/// Refuses an option the kind does not take: the first of `JointOption::ALL` given, then
+/// any key that is no option at all.
+fn check_keys(spec: &KindSpec, options: Option<&Bound<'_, PyDict>>) -> PyResult<()> {
+    let known = JointOption::ALL.iter().map(|o| o.key());
+    let mut bad = None;
+    for key in known {
+        if !spec.keys().any(|k| k == key) && given(options, key)?.is_some() {
+            bad = Some(key.to_string());
+            break;
+        }
     }
-    Ok(match name {
-        "ball" => JointKind::Ball {
-            cone: o.cone.map(real),
-            twist: range(o.twist, "twist")?,
-        },
-        "hinge" => JointKind::Hinge {
-            limits: range(o.limits, "limits")?,
-            motor: motor(o.motor)?,
-            spring: spring(o.spring)?,
-        },
-        "slider" => JointKind::Slider {
-            limits: range(o.limits, "limits")?,
-            motor: motor(o.motor)?,
-            spring: spring(o.spring)?,
-        },
-        "fixed" => JointKind::Fixed,
-        _ => JointKind::Distance {
-            length: o.length.map(real),
-            min: o.min.map(real),
-            max: o.max.map(real),
-            spring: spring(o.spring)?,
-        },
+    if bad.is_none() {
+        for (key, value) in options.iter().flat_map(|o| o.iter()) {
+            let key: String = key.extract()?;
+            if !value.is_none() && !spec.keys().any(|k| k == key) {
+                bad = Some(key);
+                break;
+            }
+        }
+    }
+    match bad {
+        None => Ok(()),
+        Some(key) => {
+            let allowed: Vec<&str> = spec.keys().collect();
+            Err(PyTypeError::new_err(format!(
+                "{key}: not an option of a {} joint (its options: {})",
+                spec.name,
+                if allowed.is_empty() {
+                    "none".to_string()
+                } else {
+                    allowed.join(", ")
+                }
+            )))
+        }
+    }
+}
+
+/// One option's value, read by its shape.
+fn option_value(option: JointOption, o: &Bound<'_, PyAny>) -> PyResult<OptionValue> {
+    let key = option.key();
+    Ok(match option.shape() {
+        OptionShape::Real => {
+            let x: f64 = o.extract().map_err(|_| wrong_type(key, "a number", o))?;
+            OptionValue::Real(real(x))
+        }
+        OptionShape::Range => {
+            let v = numbers(o, key, 2, "[lower, upper]")?;
+            OptionValue::Range([real(v[0]), real(v[1])])
+        }
+        OptionShape::Motor => {
+            let m = o
+                .cast::<PyMotor>()
+                .map_err(|_| wrong_type(key, "a tumble.Motor(speed, max_force)", o))?;
+            let m = m.get();
+            OptionValue::Motor(tumble::Motor {
+                speed: real(m.speed),
+                max_force: real(m.max_force),
+            })
+        }
+        OptionShape::Spring => {
+            let s = o
+                .cast::<PyJointSpring>()
+                .map_err(|_| wrong_type(key, "a tumble.JointSpring(hertz, ...)", o))?;
+            let s = s.get();
+            OptionValue::Spring(tumble::JointSpring {
+                hertz: real(s.hertz),
+                damping_ratio: real(s.damping_ratio),
+                target: real(s.target),
+            })
+        }
     })
+}
+
+/// The joint kind called `name` with the keyword options given, as its description
+/// (`tumble::joint::JOINT_KINDS`) lists them.
+fn kind_of(name: &str, options: Option<&Bound<'_, PyDict>>) -> PyResult<JointKind> {
+    let Some(spec) = KindSpec::named(name) else {
+        return Err(invalid(
+            "kind",
+            format!(
+                "unknown joint type '{name}' (expected one of: {})",
+                tumble_scene::JOINT_TYPES.join(", ")
+            ),
+        ));
+    };
+    check_keys(spec, options)?;
+    let mut values = JointOptions::default();
+    for option in spec.options.iter().map(|o| o.option) {
+        if let Some(o) = given(options, option.key())? {
+            values
+                .set(option, option_value(option, &o)?)
+                .map_err(engine)?;
+        }
+    }
+    JointKind::from_options(spec.name, &values)
+        .ok_or_else(|| invalid("kind", format!("unknown joint type '{name}'")))
 }
 
 /// A body's frame (origin and rotation); the world's is the identity.
@@ -292,14 +292,14 @@ impl PyWorld {
     /// `anchor` and `axis` are in `body`'s frame (m; axis default x); `other_anchor` and
     /// `other_axis` in `other`'s frame, or world coordinates when joined to the world; left
     /// out, they are where `body`'s anchor and axis are now, so the joint starts satisfied.
-    /// Options by kind: ball `cone` (rad) and `twist` [lo, hi] (rad); hinge and slider
-    /// `limits` [lo, hi] (rad or m), `motor` (tumble.Motor), `spring` (tumble.JointSpring);
-    /// distance `length`, `min`, `max` (m) and `spring`. `collide_connected` lets the two
-    /// bodies still collide; `break_force` (N) breaks the joint when exceeded.
+    /// Options by kind (keywords; None counts as left out): ball `cone` (rad) and `twist`
+    /// [lo, hi] (rad); hinge and slider `limits` [lo, hi] (rad or m), `motor`
+    /// (tumble.Motor), `spring` (tumble.JointSpring); distance `length`, `min`, `max` (m)
+    /// and `spring`. `collide_connected` lets the two bodies still collide; `break_force`
+    /// (N) breaks the joint when exceeded.
     #[pyo3(signature = (kind, body, other = None, *, anchor = None, axis = None,
         other_anchor = None, other_axis = None, name = None, collide_connected = false,
-        break_force = None, cone = None, twist = None, limits = None, motor = None,
-        spring = None, length = None, min = None, max = None))]
+        break_force = None, **options))]
     #[allow(clippy::too_many_arguments)]
     fn add_joint<'py>(
         slf: &Bound<'py, Self>,
@@ -313,26 +313,9 @@ impl PyWorld {
         name: Option<String>,
         collide_connected: bool,
         break_force: Option<f64>,
-        cone: Option<f64>,
-        twist: Option<&Bound<'py, PyAny>>,
-        limits: Option<&Bound<'py, PyAny>>,
-        motor: Option<&Bound<'py, PyAny>>,
-        spring: Option<&Bound<'py, PyAny>>,
-        length: Option<f64>,
-        min: Option<f64>,
-        max: Option<f64>,
+        options: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyJoint>> {
-        let options = Options {
-            cone,
-            twist,
-            limits,
-            motor,
-            spring,
-            length,
-            min,
-            max,
-        };
-        let kind = kind_of(&kind, &options)?;
+        let kind = kind_of(&kind, options)?;
         let id = {
             let mut g = slf.get().lock()?;
             let a = body_arg(slf, &g, body, "body")?;
@@ -373,7 +356,8 @@ impl PyWorld {
             .cast::<PyJoint>()
             .map_err(|_| wrong_type("joint", "a tumble.Joint", joint))?;
         let id = j.get().id;
-        Ok(self.lock()?.world.remove_joint(id))
+        // A stale handle is the engine's error; here it is the documented False.
+        Ok(self.lock()?.world.remove_joint(id).is_ok())
     }
 
     /// The joint called `name` (KeyError if there is none).

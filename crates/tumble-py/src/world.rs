@@ -469,7 +469,7 @@ impl PyWorld {
         other_anchor: Option<&Bound<'_, PyAny>>,
         rest_length: f64,
         damping: f64,
-    ) -> PyResult<u32> {
+    ) -> PyResult<u64> {
         let mut g = slf.get().lock()?;
         let id = body_arg(slf, &g, body, "body")?;
         let end = spring_end(slf, &g, id, world_point, other, other_anchor)?;
@@ -492,7 +492,7 @@ impl PyWorld {
         body: &Bound<'_, PyAny>,
         linear: f64,
         quadratic: f64,
-    ) -> PyResult<u32> {
+    ) -> PyResult<u64> {
         let mut g = slf.get().lock()?;
         let id = body_arg(slf, &g, body, "body")?;
         let drag = Drag {
@@ -512,7 +512,7 @@ impl PyWorld {
         force: Option<&Bound<'_, PyAny>>,
         point: Option<&Bound<'_, PyAny>>,
         torque: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<u32> {
+    ) -> PyResult<u64> {
         let mut g = slf.get().lock()?;
         let id = body_arg(slf, &g, body, "body")?;
         let applied = AppliedForce {
@@ -524,9 +524,14 @@ impl PyWorld {
         add(&mut g.world, Force::Applied(applied))
     }
 
-    /// Removes a force element by the id its `add_*` returned; False if there is none.
-    fn remove_force(&self, id: u32) -> PyResult<bool> {
-        Ok(self.lock()?.world.remove_force(ForceId(id)))
+    /// Removes a force element by the id its `add_*` returned; False if there is none
+    /// (never was, or removed already: ids are generational and never reused).
+    fn remove_force(&self, id: u64) -> PyResult<bool> {
+        let id = ForceId {
+            index: id as u32,
+            generation: (id >> 32) as u32,
+        };
+        Ok(self.lock()?.world.remove_force(id).is_ok())
     }
 
     /// Advances the world by `dt` seconds, `steps` times (default once). Long runs release
@@ -683,8 +688,11 @@ fn inertia_spec(obj: &Bound<'_, PyAny>) -> PyResult<InertiaSpec> {
     mat3_rows(obj, "inertia").map(InertiaSpec::Tensor)
 }
 
-fn add(world: &mut World, force: Force) -> PyResult<u32> {
-    world.add_force(force).map(|id| id.0).map_err(engine)
+fn add(world: &mut World, force: Force) -> PyResult<u64> {
+    world
+        .add_force(force)
+        .map(|id| (id.generation as u64) << 32 | id.index as u64)
+        .map_err(engine)
 }
 
 /// `steps` steps of `dt`, stopping at the first refusal.

@@ -206,6 +206,9 @@ def test_joint_handles():
     assert j.reaction_force.shape == (3,) and not j.broken
     assert len(world.joints) == 2
     assert world.remove_joint(j) and not j.alive and len(world.joints) == 1
+    # The handle stays dead when a new joint takes its slot.
+    k = world.add_joint("fixed", a)
+    assert not world.remove_joint(j) and not j.alive and k.alive and k != j
 
 
 def test_simulate_releases_the_interpreter():

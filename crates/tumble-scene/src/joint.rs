@@ -1,13 +1,26 @@
 //! Joints: one entry of the `joints` array. Bodies are referred to by name; `other`
 //! omitted or null joins `body` to the world.
+//!
+//! The keys a `"type"` accepts are the common keys and its options, as its description in
+//! `tumble::joint::JOINT_KINDS` lists them; each option is read by its shape (a number,
+//! `[lower, upper]`, a motor object, a spring object). Nothing here names a kind.
 
+use tumble::joint::{JointOptions, KindSpec, OptionShape, OptionValue, JOINT_KINDS};
 use tumble::{BodyId, JointDef, JointKind, JointSpring, Motor, Quat, Real, Vec3, World};
 
 use crate::error::{printable, Result};
 use crate::reader::{Node, Obj};
 
 /// Every joint type, in the order the documentation lists them.
-pub const JOINT_TYPES: [&str; 5] = ["ball", "hinge", "slider", "fixed", "distance"];
+pub const JOINT_TYPES: [&str; JOINT_KINDS.len()] = {
+    let mut names = [""; JOINT_KINDS.len()];
+    let mut i = 0;
+    while i < names.len() {
+        names[i] = JOINT_KINDS[i].name;
+        i += 1;
+    }
+    names
+};
 
 const COMMON_KEYS: [&str; 10] = [
     "type",
@@ -27,52 +40,18 @@ const COMMON_KEYS: [&str; 10] = [
 pub(crate) fn joint(node: &Node<'_>, world: &World) -> Result<JointDef> {
     let obj = node.object()?;
     let kind_name = obj.required("type")?.str()?;
-    let (kind, extra): (JointKind, &[&str]) = match kind_name {
-        "ball" => (
-            JointKind::Ball {
-                cone: obj.real("cone")?,
-                twist: range(&obj, "twist")?,
-            },
-            &["cone", "twist"],
-        ),
-        "hinge" => (
-            JointKind::Hinge {
-                limits: range(&obj, "limits")?,
-                motor: motor(&obj, "max_torque")?,
-                spring: spring(&obj)?,
-            },
-            &["limits", "motor", "spring"],
-        ),
-        "slider" => (
-            JointKind::Slider {
-                limits: range(&obj, "limits")?,
-                motor: motor(&obj, "max_force")?,
-                spring: spring(&obj)?,
-            },
-            &["limits", "motor", "spring"],
-        ),
-        "fixed" => (JointKind::Fixed, &[]),
-        "distance" => (
-            JointKind::Distance {
-                length: obj.real("length")?,
-                min: obj.real("min")?,
-                max: obj.real("max")?,
-                spring: spring(&obj)?,
-            },
-            &["length", "min", "max", "spring"],
-        ),
-        other => {
-            return Err(obj.err_at(
-                "type",
-                format!(
-                    "unknown joint type '{}' (expected one of: {})",
-                    printable(other),
-                    JOINT_TYPES.join(", ")
-                ),
-            ))
-        }
+    let Some(spec) = KindSpec::named(kind_name) else {
+        return Err(obj.err_at(
+            "type",
+            format!(
+                "unknown joint type '{}' (expected one of: {})",
+                printable(kind_name),
+                JOINT_TYPES.join(", ")
+            ),
+        ));
     };
-    let allowed: Vec<&str> = COMMON_KEYS.iter().chain(extra).copied().collect();
+    let kind = options(&obj, spec)?;
+    let allowed: Vec<&str> = COMMON_KEYS.iter().copied().chain(spec.keys()).collect();
     obj.only(&allowed)?;
     let body = named_body(obj.required("body")?, world)?;
     let other = match obj.get("other") {
@@ -107,6 +86,27 @@ pub(crate) fn joint(node: &Node<'_>, world: &World) -> Result<JointDef> {
     })
 }
 
+/// The kind's options, each read by its shape, in the description's order.
+fn options(obj: &Obj<'_>, spec: &KindSpec) -> Result<JointKind> {
+    let mut options = JointOptions::default();
+    for option in spec.options.iter().map(|o| o.option) {
+        let key = option.key();
+        let value = match option.shape() {
+            OptionShape::Real => obj.real(key)?.map(OptionValue::Real),
+            OptionShape::Range => range(obj, key)?.map(OptionValue::Range),
+            OptionShape::Motor => motor(obj, key, spec.motor_limit_key())?.map(OptionValue::Motor),
+            OptionShape::Spring => spring(obj, key)?.map(OptionValue::Spring),
+        };
+        if let Some(value) = value {
+            // Each value was read by its option's own shape.
+            options
+                .set(option, value)
+                .expect("a value of its option's shape");
+        }
+    }
+    Ok(JointKind::from_options(spec.name, &options).expect("a kind of JOINT_KINDS"))
+}
+
 /// A body's frame (origin and rotation); the world's is the identity.
 fn pose(world: &World, id: Option<BodyId>) -> (Vec3, Quat) {
     id.and_then(|id| world.body(id).ok())
@@ -122,8 +122,8 @@ fn range(obj: &Obj<'_>, key: &str) -> Result<Option<[Real; 2]>> {
 }
 
 /// `{"speed": .., "max_torque" | "max_force": ..}`.
-fn motor(obj: &Obj<'_>, limit_key: &str) -> Result<Option<Motor>> {
-    let Some(node) = obj.get("motor") else {
+fn motor(obj: &Obj<'_>, key: &str, limit_key: &str) -> Result<Option<Motor>> {
+    let Some(node) = obj.get(key) else {
         return Ok(None);
     };
     let m = node.object()?;
@@ -140,8 +140,8 @@ fn motor(obj: &Obj<'_>, limit_key: &str) -> Result<Option<Motor>> {
 }
 
 /// `{"hertz": .., "damping_ratio": .., "target": ..}`.
-fn spring(obj: &Obj<'_>) -> Result<Option<JointSpring>> {
-    let Some(node) = obj.get("spring") else {
+fn spring(obj: &Obj<'_>, key: &str) -> Result<Option<JointSpring>> {
+    let Some(node) = obj.get(key) else {
         return Ok(None);
     };
     let s = node.object()?;

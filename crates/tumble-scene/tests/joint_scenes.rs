@@ -168,3 +168,41 @@ fn joints_read_from_a_scene_with_defaults_and_named_errors() {
         assert!(err.starts_with(message), "{err}\n  expected {message}");
     }
 }
+
+#[test]
+fn each_joint_type_takes_exactly_its_described_keys_and_the_docs_list_them() {
+    // The reader's keys come from the engine's description of each kind: every option of
+    // a kind is accepted (a wrong value is refused by the engine, not as an unknown key),
+    // and the documentation's "Keys of each type" table names each of them.
+    let doc = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/scene-format.md");
+    let doc = std::fs::read_to_string(doc).unwrap();
+    let table = doc.split("Keys of each type:").nth(1).unwrap();
+    let table = table.split("\n\n").nth(1).unwrap();
+    for spec in &tumble::joint::JOINT_KINDS {
+        // The kind's rows: its own, then the continuation rows under it.
+        let own = format!("| `{}`", spec.name);
+        let rows: String = table
+            .lines()
+            .skip_while(|l| !l.starts_with(&own))
+            .enumerate()
+            .take_while(|(i, l)| *i == 0 || l.starts_with("|            |"))
+            .map(|(_, l)| l)
+            .collect();
+        assert!(!rows.is_empty(), "{} is not documented", spec.name);
+        for key in spec.keys() {
+            assert!(
+                rows.contains(&format!("`{key}`")),
+                "{}: {key} undocumented",
+                spec.name
+            );
+            let json = format!(
+                r#"{{"bodies": [{{"name": "a", "shape": {{"type": "sphere", "radius": 0.1}}}}],
+                     "joints": [{{"type": "{}", "body": "a", "{key}": "x"}}]}}"#,
+                spec.name
+            );
+            let err = load_str(&json).expect_err("accepted a string").to_string();
+            assert!(err.starts_with(&format!("joints[0].{key}")), "{err}");
+            assert!(!err.contains("unknown key"), "{err}");
+        }
+    }
+}

@@ -4,20 +4,25 @@
 //! A joint is defined, like a body, by a plain [`JointDef`] with defaults; the world checks
 //! it and keeps a [`Joint`], which also carries what the solver reports back (the reaction
 //! force and torque) and whether the joint has broken. The constraint rows live in
-//! `solver/joint.rs`.
+//! `solver/joint*.rs`.
 //!
 //! Frames: `anchor` and `axis` are in the frame of `body` (its origin, not its centre of
 //! mass); `other_anchor` and `other_axis` in the frame of `other`, or in world coordinates
 //! when `other` is `None` (the world). Angles of hinges and twists are measured from the
 //! pose the bodies have when the joint is created, which counts as zero.
+//!
+//! Each kind is described once, as data, by its [`KindSpec`] in [`JOINT_KINDS`]: what it
+//! locks ([`LinearLock`], [`AngularLock`]), its free coordinate ([`FreeAxis`]) and the
+//! options it takes ([`JointOption`], with units). Everything else is derived from that
+//! table: the solver's rows, the checks in `validate`, the keys a scene file's joint
+//! accepts and the Python binding's keywords. A kind's settings travel between its
+//! [`JointKind`] variant and the uniform [`JointOptions`] through [`JointKind::options`]
+//! and [`JointKind::from_options`], the one place a variant meets its description.
 
 use crate::error::{check, Error, Result};
 use crate::id::BodyId;
+pub use crate::id::JointId;
 use crate::math::{orthonormal_basis, Quat, Real, Vec3};
-
-/// Handle of a joint in a [`crate::World`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct JointId(pub u32);
 
 /// A velocity motor: drives the joint's free coordinate at `speed` (rad/s or m/s) with at
 /// most `max_force` (N·m for hinges, N for sliders).
@@ -86,16 +91,404 @@ pub enum JointKind {
     },
 }
 
+// ---------------------------------------------------------------------------------------
+// The kinds as data. Adding a kind: its variant above, its `KindSpec` in `JOINT_KINDS`,
+// its arms in `JointKind::options` and `JointKind::from_options`; new rows only if its
+// locks or free axis are new (`solver/joint_rows.rs`).
+// ---------------------------------------------------------------------------------------
+
+/// The relative translations a kind forbids: its linear hard rows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LinearLock {
+    /// None: the anchors may separate (a distance joint acts on its free axis only).
+    Free,
+    /// The anchors coincide: three rows, one per world axis.
+    Point,
+    /// The anchors stay on the line of `axis` through `body`'s anchor: two rows across it.
+    AcrossAxis,
+}
+
+/// The relative rotations a kind forbids: its angular hard rows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AngularLock {
+    /// None.
+    Free,
+    /// `axis` and `other_axis` stay aligned: two rows about the directions across them.
+    AcrossAxis,
+    /// No relative rotation at all: three rows, towards the orientation at creation.
+    All,
+}
+
+/// The coordinate a kind leaves free, on which its limits, motor and spring act.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FreeAxis {
+    /// Rotation about `axis` (rad): a hinge's angle.
+    Rotation,
+    /// Rotation about the bisector of the two axes (rad): a ball joint's twist. Measured
+    /// only while limited: an unlimited ball has no twist row.
+    Twist,
+    /// Translation of the anchors along `axis` (m).
+    Translation,
+    /// The anchors' distance (m), along the line between them; with no limits and no
+    /// spring it is held at the rest length (a rod).
+    Distance,
+}
+
+impl FreeAxis {
+    /// The key of a motor's force bound in scene files: a torque about rotations.
+    pub fn motor_limit_key(self) -> &'static str {
+        match self {
+            FreeAxis::Rotation | FreeAxis::Twist => "max_torque",
+            FreeAxis::Translation | FreeAxis::Distance => "max_force",
+        }
+    }
+}
+
+/// An option a kind may take, by the key scene files and Python keywords use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum JointOption {
+    /// `cone`: largest swing angle between `axis` and `other_axis`, ≥ 0.
+    Cone,
+    /// `twist`: [lower, upper] twist about the axes (the limits of [`FreeAxis::Twist`]).
+    Twist,
+    /// `limits`: [lower, upper] of the free coordinate.
+    Limits,
+    /// `motor`: a [`Motor`] on the free coordinate.
+    Motor,
+    /// `spring`: a [`JointSpring`] on the free coordinate.
+    Spring,
+    /// `length`: rest length, > 0; left out, the anchors' distance at creation.
+    Length,
+    /// `min`: shortest distance, ≥ 0.
+    Min,
+    /// `max`: longest distance, > 0 and ≥ `min`.
+    Max,
+}
+
+/// The shape of an option's value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OptionShape {
+    /// A number.
+    Real,
+    /// `[lower, upper]`.
+    Range,
+    /// A [`Motor`].
+    Motor,
+    /// A [`JointSpring`].
+    Spring,
+}
+
+impl JointOption {
+    /// Every option, in the order option errors report them.
+    pub const ALL: [JointOption; 8] = [
+        JointOption::Cone,
+        JointOption::Twist,
+        JointOption::Limits,
+        JointOption::Motor,
+        JointOption::Spring,
+        JointOption::Length,
+        JointOption::Min,
+        JointOption::Max,
+    ];
+
+    /// The key in scene files, the Python keyword and the field in error messages.
+    pub fn key(self) -> &'static str {
+        match self {
+            JointOption::Cone => "cone",
+            JointOption::Twist => "twist",
+            JointOption::Limits => "limits",
+            JointOption::Motor => "motor",
+            JointOption::Spring => "spring",
+            JointOption::Length => "length",
+            JointOption::Min => "min",
+            JointOption::Max => "max",
+        }
+    }
+
+    /// What the option's value is.
+    pub fn shape(self) -> OptionShape {
+        match self {
+            JointOption::Cone | JointOption::Length | JointOption::Min | JointOption::Max => {
+                OptionShape::Real
+            }
+            JointOption::Twist | JointOption::Limits => OptionShape::Range,
+            JointOption::Motor => OptionShape::Motor,
+            JointOption::Spring => OptionShape::Spring,
+        }
+    }
+}
+
+/// An option of a kind, with the unit of its value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OptionSpec {
+    /// Which option.
+    pub option: JointOption,
+    /// Its unit (a motor's: speed, then force bound; a spring's: its target's).
+    pub unit: &'static str,
+}
+
+/// The description of a joint kind, from which its rows, checks and accepted keys follow.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct KindSpec {
+    /// The name in scene files, Python and [`JointKind::name`].
+    pub name: &'static str,
+    /// The translations it forbids.
+    pub linear: LinearLock,
+    /// The rotations it forbids.
+    pub angular: AngularLock,
+    /// The coordinate it leaves free for limits, motor and spring, if any.
+    pub free: Option<FreeAxis>,
+    /// The options it takes, in the order they are read and checked.
+    pub options: &'static [OptionSpec],
+}
+
+const fn opt(option: JointOption, unit: &'static str) -> OptionSpec {
+    OptionSpec { option, unit }
+}
+
+/// Every joint kind, in the order the documentation lists them.
+pub const JOINT_KINDS: [KindSpec; 5] = [
+    KindSpec {
+        name: "ball",
+        linear: LinearLock::Point,
+        angular: AngularLock::Free,
+        free: Some(FreeAxis::Twist),
+        options: &[
+            opt(JointOption::Cone, "rad"),
+            opt(JointOption::Twist, "rad"),
+        ],
+    },
+    KindSpec {
+        name: "hinge",
+        linear: LinearLock::Point,
+        angular: AngularLock::AcrossAxis,
+        free: Some(FreeAxis::Rotation),
+        options: &[
+            opt(JointOption::Limits, "rad"),
+            opt(JointOption::Motor, "rad/s, N·m"),
+            opt(JointOption::Spring, "rad"),
+        ],
+    },
+    KindSpec {
+        name: "slider",
+        linear: LinearLock::AcrossAxis,
+        angular: AngularLock::All,
+        free: Some(FreeAxis::Translation),
+        options: &[
+            opt(JointOption::Limits, "m"),
+            opt(JointOption::Motor, "m/s, N"),
+            opt(JointOption::Spring, "m"),
+        ],
+    },
+    KindSpec {
+        name: "fixed",
+        linear: LinearLock::Point,
+        angular: AngularLock::All,
+        free: None,
+        options: &[],
+    },
+    KindSpec {
+        name: "distance",
+        linear: LinearLock::Free,
+        angular: AngularLock::Free,
+        free: Some(FreeAxis::Distance),
+        options: &[
+            opt(JointOption::Length, "m"),
+            opt(JointOption::Min, "m"),
+            opt(JointOption::Max, "m"),
+            opt(JointOption::Spring, "m"),
+        ],
+    },
+];
+
+impl KindSpec {
+    /// The kind called `name`.
+    pub fn named(name: &str) -> Option<&'static KindSpec> {
+        JOINT_KINDS.iter().find(|k| k.name == name)
+    }
+
+    /// Whether the kind takes `option`.
+    pub fn takes(&self, option: JointOption) -> bool {
+        self.options.iter().any(|o| o.option == option)
+    }
+
+    /// The option keys it takes, in order.
+    pub fn keys(&self) -> impl Iterator<Item = &'static str> + '_ {
+        self.options.iter().map(|o| o.option.key())
+    }
+
+    /// The key of its motor's force bound (`max_torque` or `max_force`).
+    pub fn motor_limit_key(&self) -> &'static str {
+        self.free.map_or("max_force", FreeAxis::motor_limit_key)
+    }
+}
+
+/// One option's value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum OptionValue {
+    /// For [`OptionShape::Real`].
+    Real(Real),
+    /// For [`OptionShape::Range`].
+    Range([Real; 2]),
+    /// For [`OptionShape::Motor`].
+    Motor(Motor),
+    /// For [`OptionShape::Spring`].
+    Spring(JointSpring),
+}
+
+/// Every option's value, `None` where not given: a kind's settings in one shape.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[allow(missing_docs)] // One field per `JointOption`, documented there.
+pub struct JointOptions {
+    pub cone: Option<Real>,
+    pub twist: Option<[Real; 2]>,
+    pub limits: Option<[Real; 2]>,
+    pub motor: Option<Motor>,
+    pub spring: Option<JointSpring>,
+    pub length: Option<Real>,
+    pub min: Option<Real>,
+    pub max: Option<Real>,
+}
+
+impl JointOptions {
+    /// The value of `option`, if given.
+    pub fn get(&self, option: JointOption) -> Option<OptionValue> {
+        match option {
+            JointOption::Cone => self.cone.map(OptionValue::Real),
+            JointOption::Twist => self.twist.map(OptionValue::Range),
+            JointOption::Limits => self.limits.map(OptionValue::Range),
+            JointOption::Motor => self.motor.map(OptionValue::Motor),
+            JointOption::Spring => self.spring.map(OptionValue::Spring),
+            JointOption::Length => self.length.map(OptionValue::Real),
+            JointOption::Min => self.min.map(OptionValue::Real),
+            JointOption::Max => self.max.map(OptionValue::Real),
+        }
+    }
+
+    /// Sets `option`; an error (`cone: expected a number`) for a value of another shape.
+    pub fn set(&mut self, option: JointOption, value: OptionValue) -> Result<()> {
+        match (option, value) {
+            (JointOption::Cone, OptionValue::Real(x)) => self.cone = Some(x),
+            (JointOption::Twist, OptionValue::Range(r)) => self.twist = Some(r),
+            (JointOption::Limits, OptionValue::Range(r)) => self.limits = Some(r),
+            (JointOption::Motor, OptionValue::Motor(m)) => self.motor = Some(m),
+            (JointOption::Spring, OptionValue::Spring(s)) => self.spring = Some(s),
+            (JointOption::Length, OptionValue::Real(x)) => self.length = Some(x),
+            (JointOption::Min, OptionValue::Real(x)) => self.min = Some(x),
+            (JointOption::Max, OptionValue::Real(x)) => self.max = Some(x),
+            _ => {
+                let expected = match option.shape() {
+                    OptionShape::Real => "a number",
+                    OptionShape::Range => "[lower, upper]",
+                    OptionShape::Motor => "a motor",
+                    OptionShape::Spring => "a spring",
+                };
+                return Err(Error::invalid(option.key(), format!("expected {expected}")));
+            }
+        }
+        Ok(())
+    }
+}
+
 impl JointKind {
     /// The name used in scene files.
     pub fn name(&self) -> &'static str {
-        match self {
-            JointKind::Ball { .. } => "ball",
-            JointKind::Hinge { .. } => "hinge",
-            JointKind::Slider { .. } => "slider",
-            JointKind::Fixed => "fixed",
-            JointKind::Distance { .. } => "distance",
+        self.spec().name
+    }
+
+    /// The kind's description.
+    pub fn spec(&self) -> &'static KindSpec {
+        self.parts().0
+    }
+
+    /// The kind's settings as options (those it does not take are `None`).
+    pub fn options(&self) -> JointOptions {
+        self.parts().1
+    }
+
+    fn parts(&self) -> (&'static KindSpec, JointOptions) {
+        let none = JointOptions::default();
+        match *self {
+            JointKind::Ball { cone, twist } => (
+                &JOINT_KINDS[0],
+                JointOptions {
+                    cone,
+                    twist,
+                    ..none
+                },
+            ),
+            JointKind::Hinge {
+                limits,
+                motor,
+                spring,
+            } => (
+                &JOINT_KINDS[1],
+                JointOptions {
+                    limits,
+                    motor,
+                    spring,
+                    ..none
+                },
+            ),
+            JointKind::Slider {
+                limits,
+                motor,
+                spring,
+            } => (
+                &JOINT_KINDS[2],
+                JointOptions {
+                    limits,
+                    motor,
+                    spring,
+                    ..none
+                },
+            ),
+            JointKind::Fixed => (&JOINT_KINDS[3], none),
+            JointKind::Distance {
+                length,
+                min,
+                max,
+                spring,
+            } => (
+                &JOINT_KINDS[4],
+                JointOptions {
+                    length,
+                    min,
+                    max,
+                    spring,
+                    ..none
+                },
+            ),
         }
+    }
+
+    /// The kind called `name` with the options it takes from `o` (others are ignored);
+    /// `None` for an unknown name.
+    pub fn from_options(name: &str, o: &JointOptions) -> Option<JointKind> {
+        Some(match name {
+            "ball" => JointKind::Ball {
+                cone: o.cone,
+                twist: o.twist,
+            },
+            "hinge" => JointKind::Hinge {
+                limits: o.limits,
+                motor: o.motor,
+                spring: o.spring,
+            },
+            "slider" => JointKind::Slider {
+                limits: o.limits,
+                motor: o.motor,
+                spring: o.spring,
+            },
+            "fixed" => JointKind::Fixed,
+            "distance" => JointKind::Distance {
+                length: o.length,
+                min: o.min,
+                max: o.max,
+                spring: o.spring,
+            },
+            _ => return None,
+        })
     }
 }
 
@@ -170,7 +563,7 @@ pub struct Joint {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub(crate) struct JointImpulses {
     /// The hard rows solved as one block (point, across-axis, angular lock; at most six),
-    /// in the order `solver/joint.rs` lists them.
+    /// in the order `solver/joint_rows.rs` builds them (linear lock, then angular lock).
     pub hard: [Real; 6],
     /// Lower and upper limit on the free coordinate (hinge/slider/twist/distance).
     pub lower: Real,
@@ -235,63 +628,37 @@ pub(crate) fn validate(def: &JointDef) -> Result<()> {
     if def.other == Some(def.body) {
         return Err(Error::invalid("other", "must differ from body"));
     }
-    match def.kind {
-        JointKind::Ball { cone, twist } => {
-            if let Some(c) = cone {
-                check::non_negative("cone", c)?;
-            }
-            if let Some(t) = twist {
-                check_range("twist", t)?;
-            }
-        }
-        JointKind::Hinge {
-            limits,
-            motor,
-            spring,
-        }
-        | JointKind::Slider {
-            limits,
-            motor,
-            spring,
-        } => {
-            if let Some(l) = limits {
-                check_range("limits", l)?;
-            }
-            if let Some(m) = motor {
-                check::finite("motor.speed", m.speed)?;
-                check::non_negative("motor.max_force", m.max_force)?;
-            }
-            if let Some(s) = spring {
-                check_spring("spring", &s)?;
-            }
-        }
-        JointKind::Fixed => {}
-        JointKind::Distance {
-            length,
-            min,
-            max,
-            spring,
-        } => {
-            if let Some(l) = length {
-                check::positive("length", l)?;
-            }
-            if let Some(m) = min {
-                check::non_negative("min", m)?;
-            }
-            if let Some(m) = max {
-                check::positive("max", m)?;
-            }
-            if let (Some(lo), Some(hi)) = (min, max) {
-                if lo > hi {
-                    return Err(Error::invalid("min", "must be <= max"));
-                }
-            }
-            if let Some(s) = spring {
-                check_spring("spring", &s)?;
-            }
+    let spec = def.kind.spec();
+    let options = def.kind.options();
+    for option in spec.options.iter().map(|o| o.option) {
+        if let Some(value) = options.get(option) {
+            check_option(option, value, &options)?;
         }
     }
     Ok(())
+}
+
+/// Checks one option's value (`options`: the others, for the pairs that must agree).
+fn check_option(option: JointOption, value: OptionValue, options: &JointOptions) -> Result<()> {
+    let key = option.key();
+    match (option, value) {
+        (JointOption::Cone | JointOption::Min, OptionValue::Real(x)) => check::non_negative(key, x),
+        (JointOption::Length, OptionValue::Real(x)) => check::positive(key, x),
+        (JointOption::Max, OptionValue::Real(x)) => {
+            check::positive(key, x)?;
+            match options.min {
+                Some(lo) if lo > x => Err(Error::invalid("min", "must be <= max")),
+                _ => Ok(()),
+            }
+        }
+        (_, OptionValue::Range(r)) => check_range(key, r),
+        (_, OptionValue::Motor(m)) => {
+            check::finite(&format!("{key}.speed"), m.speed)?;
+            check::non_negative(&format!("{key}.max_force"), m.max_force)
+        }
+        (_, OptionValue::Spring(sp)) => check_spring(key, &sp),
+        (_, OptionValue::Real(x)) => check::finite(key, x),
+    }
 }
 
 fn check_range(field: &str, [lo, hi]: [Real; 2]) -> Result<()> {
@@ -324,11 +691,9 @@ pub(crate) fn build(def: &JointDef, body: (Vec3, Quat), other: Option<(Vec3, Qua
         .unwrap_or_else(|| orthonormal_basis(other_axis)[0]);
     let world_a = pa + qa * def.anchor;
     let world_b = pb + qb * def.other_anchor;
-    let length = match def.kind {
-        JointKind::Distance {
-            length: Some(l), ..
-        } => l,
-        _ => (world_b - world_a).length(),
+    let length = match def.kind.options().length {
+        Some(l) => l,
+        None => (world_b - world_a).length(),
     };
     Joint {
         def: def.clone(),

@@ -23,6 +23,7 @@ pub mod diagnostics;
 pub mod error;
 pub mod force;
 pub mod geometry;
+pub(crate) mod handles;
 pub mod id;
 pub mod integrate;
 pub(crate) mod island;

@@ -104,7 +104,7 @@ impl World {
     /// Islands touched by an awake body or a joint to one wake.
     fn wake_touched(&mut self) {
         let contacts = self.collision.contacts.contacts();
-        crate::island::wake_touched(&mut self.bodies.list, contacts, &self.joint_bodies);
+        crate::island::wake_touched(&mut self.bodies.list, contacts, &self.joints.links);
     }
 
     /// Marks the bodies the solver advances (awake dynamic bodies with a contact that has
@@ -120,7 +120,7 @@ impl World {
             .iter()
             .filter(|c| !c.manifold.is_empty())
             .flat_map(|c| [c.index_a as usize, c.index_b as usize]);
-        let joined = self.joint_bodies.iter().flatten().flatten().copied();
+        let joined = self.joints.links.iter().flatten().flatten().copied();
         for i in touching.chain(joined) {
             if bodies[i].kind == BodyKind::Dynamic && bodies[i].awake {
                 ctx.solved[i] = true;
@@ -163,8 +163,8 @@ impl World {
         ctx.ode.clear();
         ctx.ode
             .extend((0..bodies.len()).map(|i| ctx.bodies.motion(i)));
-        let slots = &self.bodies.slots;
-        let find = |id: BodyId| crate::world::lookup(slots, id);
+        let handles = &self.bodies.handles;
+        let find = |id: BodyId| handles.dense(id);
         let mut system = system(&self.settings, &mut self.forces, bodies, &find);
         integrate::advance(
             self.settings.integrator,
@@ -192,16 +192,16 @@ impl World {
         for (i, _) in ctx.solved.iter().enumerate().filter(|(_, s)| **s) {
             self.memory.forget(i);
         }
-        let slots = &self.bodies.slots;
-        let find = |id: BodyId| crate::world::lookup(slots, id);
+        let handles = &self.bodies.handles;
+        let find = |id: BodyId| handles.dense(id);
         let mut system = system(&self.settings, &mut self.forces, &self.bodies.list, &find);
         let input = StepInput {
             system: &mut system,
             settings: &self.settings.solver,
             scales: &self.settings.tolerances.scales,
             ghosts: &ctx.ghosts,
-            joints: &mut self.joints,
-            joint_bodies: &self.joint_bodies,
+            joints: &mut self.joints.list,
+            joint_bodies: &self.joints.links,
             time,
         };
         let contacts = self.collision.contacts.contacts_mut();
@@ -263,7 +263,7 @@ impl World {
             crate::island::update_sleep(
                 &mut self.bodies.list,
                 self.collision.contacts.contacts(),
-                &self.joint_bodies,
+                &self.joints.links,
                 time.dt,
                 self.settings.tolerances.sleep_speed,
                 &mut self.sleep_tag,

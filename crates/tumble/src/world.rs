@@ -25,6 +25,7 @@ use crate::contact_cache::{Contact, ContactCache, ContactEvent};
 use crate::diagnostics::{self, Diagnostics};
 use crate::error::{check, Error, Result};
 use crate::force::{Force, ForceCallback};
+use crate::handles::Handles;
 use crate::id::{BodyId, ForceId};
 use crate::integrate::{Integrator, IntegratorMemory};
 use crate::joint::{Joint, JointId};
@@ -92,13 +93,6 @@ impl Tolerances {
     }
 }
 
-/// A body handle's slot: its generation and, while the body lives, its dense index.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Slot {
-    pub generation: u32,
-    pub dense: Option<u32>,
-}
-
 /// The world's settings: what the user chose, and the tolerances derived from it.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Settings {
@@ -120,17 +114,18 @@ pub(crate) struct Clock {
 #[derive(Default)]
 pub(crate) struct BodyStore {
     pub list: Vec<Body>,
-    /// Each dense body's handle.
-    pub ids: Vec<BodyId>,
-    /// Handle slots (`ids[k].index` indexes them) and the free ones, reused last-freed first.
-    pub slots: Vec<Slot>,
-    pub free: Vec<u32>,
+    pub handles: Handles<BodyId>,
 }
 
 impl BodyStore {
     /// The dense index of the live body `id`.
     pub fn dense(&self, id: BodyId) -> Option<usize> {
-        lookup(&self.slots, id)
+        self.handles.dense(id)
+    }
+
+    /// Each dense body's handle.
+    pub fn ids(&self) -> &[BodyId] {
+        self.handles.ids()
     }
 }
 
@@ -138,9 +133,20 @@ impl BodyStore {
 #[derive(Default)]
 pub(crate) struct ForceStore {
     pub list: Vec<Force>,
-    pub ids: Vec<ForceId>,
-    pub next_id: u32,
+    pub handles: Handles<ForceId>,
     pub callbacks: Vec<ForceCallback>,
+}
+
+/// Joints in creation order with their handles (see `world_joints.rs`), and what each
+/// step re-derives of them before anything reads it.
+#[derive(Default)]
+pub(crate) struct JointStore {
+    pub list: Vec<Joint>,
+    pub handles: Handles<JointId>,
+    /// Each joint's bodies as dense indices (`None`: the world, or a broken joint).
+    pub links: Vec<[Option<usize>; 2]>,
+    /// Dense body pairs a joint keeps from colliding, sorted.
+    pub joined_pairs: Vec<(u32, u32)>,
 }
 
 /// What collision detection keeps between steps.
@@ -157,14 +163,7 @@ pub struct World {
     pub(crate) clock: Clock,
     pub(crate) bodies: BodyStore,
     pub(crate) forces: ForceStore,
-    /// Joints in creation order, with their handles (see `world_joints.rs`).
-    pub(crate) joints: Vec<Joint>,
-    pub(crate) joint_ids: Vec<JointId>,
-    pub(crate) next_joint_id: u32,
-    /// Each joint's bodies as dense indices, re-derived every step.
-    pub(crate) joint_bodies: Vec<[Option<usize>; 2]>,
-    /// Dense body pairs a joint keeps from colliding, sorted, re-derived every step.
-    pub(crate) joined_pairs: Vec<(u32, u32)>,
+    pub(crate) joints: JointStore,
     pub(crate) collision: CollisionStore,
     /// The islands' tag counter (see `island.rs`).
     pub(crate) sleep_tag: u32,
@@ -203,11 +202,7 @@ impl World {
             clock: Clock::default(),
             bodies: BodyStore::default(),
             forces: ForceStore::default(),
-            joints: Vec::new(),
-            joint_ids: Vec::new(),
-            next_joint_id: 0,
-            joint_bodies: Vec::new(),
-            joined_pairs: Vec::new(),
+            joints: JointStore::default(),
             collision: CollisionStore {
                 broad_phase: BroadPhase::new(tolerances.aabb_margin),
                 proxies: Vec::new(),
@@ -306,9 +301,9 @@ impl World {
         c.contacts.update(
             &mut c.broad_phase,
             &self.bodies.list,
-            &self.bodies.ids,
+            self.bodies.ids(),
             self.settings.tolerances.contact_margin,
-            &self.joined_pairs,
+            &self.joints.joined_pairs,
         );
         c.contacts.contacts()
     }
@@ -338,13 +333,4 @@ impl World {
     pub fn state_hash(&self) -> u64 {
         diagnostics::state_hash(&self.bodies.list)
     }
-}
-
-/// The dense index of the live body `id` in `slots`.
-pub(crate) fn lookup(slots: &[Slot], id: BodyId) -> Option<usize> {
-    slots
-        .get(id.index as usize)
-        .filter(|s| s.generation == id.generation)
-        .and_then(|s| s.dense)
-        .map(|d| d as usize)
 }

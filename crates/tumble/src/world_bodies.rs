@@ -8,7 +8,7 @@ use crate::error::{check, Error, Result};
 use crate::id::BodyId;
 use crate::math::{Quat, Vec3};
 use crate::shape::Shape;
-use crate::world::{Slot, World};
+use crate::world::World;
 
 impl World {
     /// Creates a body; fails (changing nothing) if the definition or shape is invalid or
@@ -24,22 +24,7 @@ impl World {
         }
         let body = Body::new(def, shape)?;
         let store = &mut self.bodies;
-        let index = match store.free.pop() {
-            Some(i) => i,
-            None => {
-                store.slots.push(Slot {
-                    generation: 0,
-                    dense: None,
-                });
-                (store.slots.len() - 1) as u32
-            }
-        };
-        let slot = &mut store.slots[index as usize];
-        slot.dense = Some(store.list.len() as u32);
-        let id = BodyId {
-            index,
-            generation: slot.generation,
-        };
+        let id = store.handles.insert();
         let kind = if body.kind == BodyKind::Static {
             ProxyKind::Static
         } else {
@@ -53,7 +38,6 @@ impl World {
         );
         self.collision.proxies.push(proxy);
         store.list.push(body);
-        store.ids.push(id);
         self.memory.push();
         Ok(id)
     }
@@ -68,7 +52,7 @@ impl World {
         self.wake_around(dense);
         // Keep creation order (outputs list bodies in it); removal is rare.
         self.bodies.list.remove(dense);
-        self.bodies.ids.remove(dense);
+        self.bodies.handles.remove(id);
         self.memory.remove(dense);
         let c = &mut self.collision;
         c.broad_phase.remove(c.proxies.remove(dense));
@@ -77,14 +61,6 @@ impl World {
         }
         c.contacts.forget(id, dense);
         self.remove_joints_of(id);
-        let store = &mut self.bodies;
-        let slot = &mut store.slots[id.index as usize];
-        slot.dense = None;
-        slot.generation = slot.generation.wrapping_add(1);
-        store.free.push(id.index);
-        for (i, other) in store.ids.iter().enumerate().skip(dense) {
-            store.slots[other.index as usize].dense = Some(i as u32);
-        }
         self.remove_forces_of(id);
         Ok(())
     }
@@ -111,22 +87,26 @@ impl World {
             .list
             .iter()
             .position(|b| b.name.as_deref() == Some(name))
-            .map(|i| self.bodies.ids[i])
+            .map(|i| self.bodies.ids()[i])
     }
 
     /// Handles of all bodies, in creation order.
     pub fn body_ids(&self) -> &[BodyId] {
-        &self.bodies.ids
+        self.bodies.ids()
     }
 
     /// All bodies with their handles, in creation order.
     pub fn bodies(&self) -> impl Iterator<Item = (BodyId, &Body)> {
-        self.bodies.ids.iter().copied().zip(self.bodies.list.iter())
+        self.bodies
+            .ids()
+            .iter()
+            .copied()
+            .zip(self.bodies.list.iter())
     }
 
     /// The body at dense index `i` (creation order) with its id.
     pub(crate) fn body_at(&self, i: usize) -> Option<(BodyId, &Body)> {
-        Some((*self.bodies.ids.get(i)?, self.bodies.list.get(i)?))
+        Some((*self.bodies.ids().get(i)?, self.bodies.list.get(i)?))
     }
 
     /// Number of bodies.

@@ -24,25 +24,23 @@ impl World {
                 });
             }
         }
-        let id = ForceId(self.forces.next_id);
-        self.forces.next_id += 1;
         self.wake_force_bodies(&force);
+        let id = self.forces.handles.insert();
         self.forces.list.push(force);
-        self.forces.ids.push(id);
         Ok(id)
     }
 
-    /// Removes a force element; false if there was none with this id.
-    pub fn remove_force(&mut self, id: ForceId) -> bool {
-        match self.forces.ids.iter().position(|f| *f == id) {
-            Some(i) => {
-                let force = self.forces.list.remove(i);
-                self.wake_force_bodies(&force);
-                self.forces.ids.remove(i);
-                true
-            }
-            None => false,
-        }
+    /// Removes a force element, waking the bodies it acted on. Fails, changing nothing,
+    /// on an unknown or stale handle (`force: unknown or removed force ...`), as
+    /// `remove_body` and `remove_joint` do.
+    pub fn remove_force(&mut self, id: ForceId) -> Result<()> {
+        let i =
+            self.forces.handles.remove(id).ok_or_else(|| {
+                Error::invalid("force", format!("unknown or removed force {id:?}"))
+            })?;
+        let force = self.forces.list.remove(i);
+        self.wake_force_bodies(&force);
+        Ok(())
     }
 
     fn wake_force_bodies(&mut self, force: &Force) {
@@ -56,7 +54,12 @@ impl World {
 
     /// The force elements with their ids.
     pub fn forces(&self) -> impl Iterator<Item = (ForceId, &Force)> {
-        self.forces.ids.iter().copied().zip(self.forces.list.iter())
+        self.forces
+            .handles
+            .ids()
+            .iter()
+            .copied()
+            .zip(self.forces.list.iter())
     }
 
     /// Adds a user force function, evaluated with every other force.
@@ -66,18 +69,19 @@ impl World {
 
     /// Removes every force element attached to `body` (the body is being removed).
     pub(crate) fn remove_forces_of(&mut self, body: BodyId) {
-        let store = &mut self.forces;
-        let keep: Vec<bool> = store
-            .list
-            .iter()
-            .map(|f| {
+        let attached: Vec<ForceId> = self
+            .forces()
+            .filter(|(_, f)| {
                 let (a, b) = f.bodies();
-                a != body && b != Some(body)
+                a == body || b == Some(body)
             })
+            .map(|(id, _)| id)
             .collect();
-        let mut k = keep.iter();
-        store.list.retain(|_| *k.next().unwrap_or(&true));
-        let mut k = keep.iter();
-        store.ids.retain(|_| *k.next().unwrap_or(&true));
+        for id in attached {
+            let i = self.forces.handles.remove(id);
+            if let Some(i) = i {
+                self.forces.list.remove(i);
+            }
+        }
     }
 }

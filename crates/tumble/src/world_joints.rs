@@ -37,10 +37,8 @@ impl World {
             (p.position, p.rotation)
         };
         let joint = joint::build(def, pose(a), b.map(pose));
-        let id = JointId(self.next_joint_id);
-        self.next_joint_id += 1;
-        self.joints.push(joint);
-        self.joint_ids.push(id);
+        let id = self.joints.handles.insert();
+        self.joints.list.push(joint);
         self.wake_around(a);
         if let Some(b) = b {
             self.wake_around(b);
@@ -49,13 +47,11 @@ impl World {
         Ok(id)
     }
 
-    /// Removes a joint, waking the bodies it held; false if there is no such joint.
-    pub fn remove_joint(&mut self, id: JointId) -> bool {
-        let Some(k) = self.joint_ids.iter().position(|j| *j == id) else {
-            return false;
-        };
-        let joint = self.joints.remove(k);
-        self.joint_ids.remove(k);
+    /// Removes a joint, waking the bodies it held. Fails, changing nothing, on an unknown
+    /// or stale handle (`joint: unknown or removed joint ...`), as `remove_body` does.
+    pub fn remove_joint(&mut self, id: JointId) -> Result<()> {
+        let k = self.joints.handles.remove(id).ok_or_else(|| unknown(id))?;
+        let joint = self.joints.list.remove(k);
         for body in [Some(joint.def.body), joint.def.other]
             .into_iter()
             .flatten()
@@ -65,29 +61,35 @@ impl World {
             }
         }
         self.refresh_joint_links();
-        true
+        Ok(())
     }
 
-    /// The joint with handle `id`.
+    /// The joint with handle `id`; an error for an unknown or stale handle.
     pub fn joint(&self, id: JointId) -> Result<&Joint> {
-        self.joint_ids
-            .iter()
-            .position(|j| *j == id)
-            .map(|k| &self.joints[k])
-            .ok_or_else(|| Error::invalid("joint", format!("unknown or removed joint {id:?}")))
+        self.joints
+            .handles
+            .dense(id)
+            .map(|k| &self.joints.list[k])
+            .ok_or_else(|| unknown(id))
     }
 
     /// The handle of the joint called `name`.
     pub fn find_joint(&self, name: &str) -> Option<JointId> {
         self.joints
+            .list
             .iter()
             .position(|j| j.def.name.as_deref() == Some(name))
-            .map(|k| self.joint_ids[k])
+            .map(|k| self.joints.handles.ids()[k])
     }
 
     /// All joints with their handles, in creation order.
     pub fn joints(&self) -> impl Iterator<Item = (JointId, &Joint)> {
-        self.joint_ids.iter().copied().zip(self.joints.iter())
+        self.joints
+            .handles
+            .ids()
+            .iter()
+            .copied()
+            .zip(self.joints.list.iter())
     }
 
     /// Removes every joint attached to `body` (the body is being removed).
@@ -98,7 +100,8 @@ impl World {
             .map(|(id, _)| id)
             .collect();
         for id in attached {
-            self.remove_joint(id);
+            // Just listed, so live: removal cannot fail.
+            let _ = self.remove_joint(id);
         }
     }
 
@@ -107,6 +110,7 @@ impl World {
     pub(crate) fn refresh_joint_links(&mut self) {
         let links: Vec<[Option<usize>; 2]> = self
             .joints
+            .list
             .iter()
             .map(|j| {
                 if j.broken {
@@ -119,16 +123,23 @@ impl World {
                 }
             })
             .collect();
-        self.joined_pairs.clear();
-        for (j, link) in self.joints.iter().zip(&links) {
+        self.joints.joined_pairs.clear();
+        for (j, link) in self.joints.list.iter().zip(&links) {
             if let [Some(a), Some(b)] = *link {
                 if !j.def.collide_connected {
-                    self.joined_pairs.push((a.min(b) as u32, a.max(b) as u32));
+                    self.joints
+                        .joined_pairs
+                        .push((a.min(b) as u32, a.max(b) as u32));
                 }
             }
         }
-        self.joined_pairs.sort_unstable();
-        self.joined_pairs.dedup();
-        self.joint_bodies = links;
+        self.joints.joined_pairs.sort_unstable();
+        self.joints.joined_pairs.dedup();
+        self.joints.links = links;
     }
+}
+
+/// The error for a handle naming no live joint.
+fn unknown(id: JointId) -> Error {
+    Error::invalid("joint", format!("unknown or removed joint {id:?}"))
 }

@@ -681,3 +681,69 @@ fn a_pendulum_bouncing_off_a_wall_never_gains_energy() {
         "the bounces took no energy"
     );
 }
+
+#[test]
+fn joint_handles_are_generational_and_removal_reports_stale_ones() {
+    // A removed joint's handle stays dead even after a new joint takes its slot, and
+    // removing it again is an error, as for bodies.
+    let mut w = world_with(Vec3::ZERO);
+    let ball = w
+        .create_body(&BodyDef::default(), Shape::sphere(0.1))
+        .unwrap();
+    let first = w
+        .create_joint(&JointDef::new(JointKind::Fixed, ball))
+        .unwrap();
+    let second = w
+        .create_joint(&JointDef::new(JointKind::Fixed, ball))
+        .unwrap();
+    w.remove_joint(first).unwrap();
+    let err = w.remove_joint(first).unwrap_err().to_string();
+    assert!(err.contains("unknown or removed joint"), "{err}");
+    let third = w
+        .create_joint(&JointDef::new(JointKind::Fixed, ball))
+        .unwrap();
+    assert_eq!(third.index, first.index);
+    assert_ne!(third, first);
+    assert!(w.joint(first).is_err());
+    let ids: Vec<JointId> = w.joints().map(|(id, _)| id).collect();
+    assert_eq!(ids, [second, third]);
+    w.remove_body(ball).unwrap();
+    assert_eq!(w.joints().count(), 0);
+    assert!(w.remove_joint(third).is_err());
+}
+
+#[test]
+fn every_kind_is_described_and_its_options_round_trip() {
+    // The description table and the variants agree: each kind's options come back from
+    // `from_options` unchanged, and an option it does not take is dropped.
+    use tumble::joint::{JointOptions, JOINT_KINDS};
+    let given = JointOptions {
+        cone: Some(0.5),
+        twist: Some([-0.1, 0.2]),
+        limits: Some([-1.0, 1.0]),
+        motor: Some(Motor {
+            speed: 1.0,
+            max_force: 2.0,
+        }),
+        spring: Some(JointSpring {
+            hertz: 3.0,
+            damping_ratio: 0.5,
+            target: 0.1,
+        }),
+        length: Some(1.5),
+        min: Some(0.5),
+        max: Some(2.0),
+    };
+    for spec in &JOINT_KINDS {
+        let kind = JointKind::from_options(spec.name, &given).unwrap();
+        assert_eq!(kind.name(), spec.name);
+        assert_eq!(kind.spec(), spec);
+        let back = kind.options();
+        for option in tumble::joint::JointOption::ALL {
+            let expected = given.get(option).filter(|_| spec.takes(option));
+            assert_eq!(back.get(option), expected, "{} {option:?}", spec.name);
+        }
+        assert_eq!(JointKind::from_options(spec.name, &back), Some(kind));
+    }
+    assert_eq!(JointKind::from_options("weld", &given), None);
+}

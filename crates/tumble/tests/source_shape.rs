@@ -24,7 +24,11 @@ fn sources() -> Vec<(String, String)> {
             if path.is_dir() {
                 dirs.push(path);
             } else if path.extension().is_some_and(|e| e == "rs") {
-                let rel = path.strip_prefix(&root).unwrap().to_string_lossy().into_owned();
+                let rel = path
+                    .strip_prefix(&root)
+                    .unwrap()
+                    .to_string_lossy()
+                    .into_owned();
                 let text = std::fs::read_to_string(&path).expect("source is text");
                 files.push((rel.replace('\\', "/"), text));
             }
@@ -74,10 +78,16 @@ fn imports(text: &str, modules: &BTreeSet<Vec<String>>) -> BTreeSet<Vec<String>>
             let rest = &line[at + "crate::".len()..];
             let path: Vec<String> = rest
                 .split("::")
-                .map(|p| p.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect())
+                .map(|p| {
+                    p.chars()
+                        .take_while(|c| c.is_alphanumeric() || *c == '_')
+                        .collect()
+                })
                 .take_while(|p: &String| !p.is_empty())
                 .collect();
-            let known = (1..=path.len()).rev().find(|&n| modules.contains(&path[..n]));
+            let known = (1..=path.len())
+                .rev()
+                .find(|&n| modules.contains(&path[..n]));
             if let Some(n) = known {
                 out.insert(path[..n].to_vec());
             }
@@ -152,7 +162,11 @@ fn modules_import_each_other_in_no_circle() {
     let mut colour = BTreeMap::new();
     for node in graph.keys() {
         let circle = visit(node, &graph, &mut colour, &mut Vec::new());
-        assert!(circle.is_none(), "import circle: {}", circle.unwrap().join(" -> "));
+        assert!(
+            circle.is_none(),
+            "import circle: {}",
+            circle.unwrap().join(" -> ")
+        );
     }
 }
 
@@ -162,12 +176,21 @@ fn function_lengths(text: &str) -> Vec<(usize, String, usize)> {
     let mut out = Vec::new();
     for (i, line) in lines.iter().enumerate() {
         let trimmed = line.trim_start();
-        let after_fn = ["fn ", "pub fn ", "pub(crate) fn ", "pub(super) fn ", "const fn "]
-            .iter()
-            .chain(&["unsafe fn ", "pub(crate) unsafe fn ", "pub unsafe fn "])
-            .find_map(|p| trimmed.strip_prefix(p));
+        let after_fn = [
+            "fn ",
+            "pub fn ",
+            "pub(crate) fn ",
+            "pub(super) fn ",
+            "const fn ",
+        ]
+        .iter()
+        .chain(&["unsafe fn ", "pub(crate) unsafe fn ", "pub unsafe fn "])
+        .find_map(|p| trimmed.strip_prefix(p));
         let Some(rest) = after_fn else { continue };
-        let name: String = rest.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+        let name: String = rest
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect();
         let (mut depth, mut opened) = (0i64, false);
         for (j, l) in lines.iter().enumerate().skip(i) {
             for ch in l.chars() {
@@ -203,7 +226,10 @@ fn no_function_is_longer_than_a_screen_and_a_half() {
             }
         }
     }
-    assert!(long.is_empty(), "functions over {MAX_FUNCTION_LINES} lines: {long:?}");
+    assert!(
+        long.is_empty(),
+        "functions over {MAX_FUNCTION_LINES} lines: {long:?}"
+    );
 }
 
 #[test]
@@ -214,8 +240,14 @@ fn the_checks_see_what_they_check() {
     let text = format!("fn long() {{\n{body}}}\n");
     assert_eq!(function_lengths(&text), vec![(1, "long".to_string(), 100)]);
     let modules: BTreeSet<Vec<String>> = [vec!["dynamics".into(), "body".into()]].into();
-    let found = imports("use crate::dynamics::body::{Body, Motion}; // crate::x", &modules);
-    assert_eq!(found, [vec!["dynamics".to_string(), "body".to_string()]].into());
+    let found = imports(
+        "use crate::dynamics::body::{Body, Motion}; // crate::x",
+        &modules,
+    );
+    assert_eq!(
+        found,
+        [vec!["dynamics".to_string(), "body".to_string()]].into()
+    );
     let unit = unit_of(&module_of("dynamics/solver/contact.rs"));
     assert_eq!((unit.as_str(), layer_of(&unit)), ("dynamics::solver", 2));
     assert_eq!(layer_of(&unit_of(&module_of("math.rs"))), 0);

@@ -196,8 +196,12 @@ fn springs_world(integrator: Integrator, state: &[(Vec3, Vec3)]) -> (World, Vec<
             damping: 0.3,
         })
     };
-    w.add_force(spring(ids[0], SpringEnd::World(Vec3::new(0.0, 2.0, 0.0)), 80.0))
-        .unwrap();
+    w.add_force(spring(
+        ids[0],
+        SpringEnd::World(Vec3::new(0.0, 2.0, 0.0)),
+        80.0,
+    ))
+    .unwrap();
     let other = SpringEnd::Body {
         body: ids[0],
         anchor: Vec3::ZERO,

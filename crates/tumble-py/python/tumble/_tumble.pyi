@@ -385,6 +385,8 @@ class World:
         name: Optional[str] = None,
         collide_connected: bool = False,
         break_force: Optional[float] = None,
+        # The options each kind takes (tumble::joint::JOINT_KINDS); another kind's is a
+        # TypeError, None counts as left out.
         cone: Optional[float] = None,
         twist: Optional[Sequence[float]] = None,
         limits: Optional[Sequence[float]] = None,

@@ -57,7 +57,13 @@ pub(super) fn midpoint(
 }
 
 /// Classic RK4: y₊ = y + dt/6 (k₁ + 2k₂ + 2k₃ + k₄).
-pub(super) fn rk4(sys: &mut System<'_>, motions: &mut [Motion], t: Real, dt: Real, s: &mut Scratch) {
+pub(super) fn rk4(
+    sys: &mut System<'_>,
+    motions: &mut [Motion],
+    t: Real,
+    dt: Real,
+    s: &mut Scratch,
+) {
     let [k1, k2, k3, k4] = &mut s.rates;
     eval(sys, t, &s.start, &mut s.wrench, k1);
     euler_update(sys, &s.start, k1, 0.5 * dt, &mut s.stage);
