@@ -32,6 +32,26 @@ pub(crate) trait Handle: Copy + Eq {
     fn generation(self) -> u32;
 }
 
+macro_rules! generational {
+    ($($id:ident),*) => {$(
+        impl Handle for $id {
+            fn from_parts(index: u32, generation: u32) -> Self {
+                $id { index, generation }
+            }
+            fn index(self) -> u32 {
+                self.index
+            }
+            fn generation(self) -> u32 {
+                self.generation
+            }
+        }
+    )*};
+}
+
+generational!(BodyId, JointId, ForceId);
+
+use crate::id::{BodyId, ForceId, JointId};
+
 #[derive(Debug, Clone, Copy)]
 struct Slot {
     generation: u32,

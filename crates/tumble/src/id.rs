@@ -1,8 +1,6 @@
 //! Generational handles. A handle is `Copy` and cheap; a stale one is an error, never a
 //! silent reference to whatever body reused its slot (see `handles.rs` for the store).
 
-use crate::handles::Handle;
-
 /// Handle of a body in a [`crate::World`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct BodyId {
@@ -29,21 +27,3 @@ pub struct ForceId {
     /// Generation of the slot when the force element was added.
     pub generation: u32,
 }
-
-macro_rules! generational {
-    ($($id:ident),*) => {$(
-        impl Handle for $id {
-            fn from_parts(index: u32, generation: u32) -> Self {
-                $id { index, generation }
-            }
-            fn index(self) -> u32 {
-                self.index
-            }
-            fn generation(self) -> u32 {
-                self.generation
-            }
-        }
-    )*};
-}
-
-generational!(BodyId, JointId, ForceId);

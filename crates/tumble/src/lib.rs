@@ -14,46 +14,34 @@
 //! ```
 #![warn(missing_docs)]
 
-pub mod analysis;
-pub mod body;
-pub mod broad_phase;
-pub(crate) mod ccd;
-pub mod contact_cache;
-pub mod diagnostics;
+pub mod collision;
+pub mod dynamics;
 pub mod error;
-pub mod force;
-pub mod geometry;
 pub(crate) mod handles;
 pub mod id;
-pub mod integrate;
-pub(crate) mod island;
-pub mod joint;
 pub mod math;
-pub mod narrow_phase;
-pub mod query;
-pub mod shape;
-pub mod solver;
-pub(crate) mod speculative;
-mod step;
-pub mod world;
-mod world_bodies;
-mod world_forces;
-mod world_joints;
-pub mod world_query;
+pub mod pipeline;
+
+// The modules under their short names, as before the layers: `tumble::shape::Shape`.
+pub use collision::{broad_phase, geometry, narrow_phase, query, shape};
+pub use dynamics::{body, force, integrate, joint, solver};
+pub use pipeline::world::query as world_query;
+pub use pipeline::{analysis, contact_cache, diagnostics, world};
 
 pub use body::{Body, BodyDef, BodyKind, InertiaSpec, MassSpec};
-pub use contact_cache::{Contact, ContactEvent, ContactEventKind};
+pub use collision::contact::{Contact, ContactEvent, ContactEventKind};
 pub use diagnostics::Diagnostics;
 pub use error::{Error, Result};
 pub use force::{
     AppliedForce, Drag, Force, ForceCallback, ForceContext, Spring, SpringEnd, Wrench,
 };
-pub use geometry::{Aabb, Convex, Pose, Ray, RayHit};
+pub use geometry::{Aabb, Pose, Ray, RayHit};
 pub use id::{BodyId, ForceId};
 pub use integrate::Integrator;
 pub use joint::{Joint, JointDef, JointId, JointKind, JointSpring, Motor};
 pub use math::{Mat3, Quat, Real, Vec3};
 pub use narrow_phase::{ContactPoint, Manifold};
+pub use shape::Convex;
 pub use shape::{CompoundChild, ConvexHull, HeightField, MassProperties, Shape, TriMesh};
 pub use solver::{SolverKind, SolverSettings};
 pub use world::{World, WorldDef};

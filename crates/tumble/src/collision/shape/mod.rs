@@ -1,0 +1,252 @@
+//! Collision and mass shapes. Each shape is defined in its body's local frame; capsules and
+//! cylinders run along the local y axis.
+
+mod bounds;
+mod convex;
+mod heightfield;
+mod hull;
+mod mass;
+mod trimesh;
+
+pub use bounds::{convex_aabb, PLANE_EXTENT};
+pub use convex::Convex;
+pub use heightfield::HeightField;
+pub use hull::ConvexHull;
+pub use mass::MassProperties;
+pub use trimesh::{EdgeKind, TriMesh, FLAT_EDGE_ANGLE};
+
+use crate::error::{check, Error, Result};
+use crate::math::{Quat, Real, Vec3};
+
+/// A child of a [`Shape::Compound`], placed in the compound's frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompoundChild {
+    /// The child's shape.
+    pub shape: Shape,
+    /// Offset of the child's frame in the parent frame (m).
+    pub position: Vec3,
+    /// Rotation of the child's frame in the parent frame, [x, y, z, w].
+    pub orientation: Quat,
+}
+
+/// A body's shape.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Shape {
+    /// A ball centred on the origin.
+    Sphere {
+        /// Radius (m).
+        radius: Real,
+    },
+    /// A box centred on the origin.
+    Box {
+        /// Half the side lengths along x, y, z (m).
+        half_extents: Vec3,
+    },
+    /// A cylinder with hemispherical caps, along the local y axis.
+    Capsule {
+        /// Radius of the caps and the shaft (m).
+        radius: Real,
+        /// Half the length of the shaft, caps excluded (m).
+        half_height: Real,
+    },
+    /// A solid circular cylinder along the local y axis.
+    Cylinder {
+        /// Radius (m).
+        radius: Real,
+        /// Half the length (m).
+        half_height: Real,
+    },
+    /// The convex hull of a point cloud.
+    ConvexHull(ConvexHull),
+    /// Several shapes rigidly joined.
+    Compound(Vec<CompoundChild>),
+    /// The half-space n·x ≤ offset (body frame): an infinite floor or wall. Static only.
+    Plane {
+        /// Outward unit normal (normalised on validation).
+        normal: Vec3,
+        /// Distance of the surface from the origin along the normal (m).
+        offset: Real,
+    },
+    /// A triangle mesh. Static only.
+    TriMesh(TriMesh),
+    /// A height-field terrain. Static only.
+    HeightField(HeightField),
+}
+
+impl Shape {
+    /// A sphere of `radius` (m).
+    pub fn sphere(radius: Real) -> Shape {
+        Shape::Sphere { radius }
+    }
+
+    /// A box of the given half extents (m).
+    pub fn cuboid(half_extents: Vec3) -> Shape {
+        Shape::Box { half_extents }
+    }
+
+    /// A capsule along y.
+    pub fn capsule(radius: Real, half_height: Real) -> Shape {
+        Shape::Capsule {
+            radius,
+            half_height,
+        }
+    }
+
+    /// A cylinder along y.
+    pub fn cylinder(radius: Real, half_height: Real) -> Shape {
+        Shape::Cylinder {
+            radius,
+            half_height,
+        }
+    }
+
+    /// The convex hull of `points`; fails on fewer than 4 non-coplanar points.
+    pub fn convex_hull(points: &[Vec3]) -> Result<Shape> {
+        Ok(Shape::ConvexHull(ConvexHull::from_points(points)?))
+    }
+
+    /// Short lowercase name of the kind, as in scene files.
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Shape::Sphere { .. } => "sphere",
+            Shape::Box { .. } => "box",
+            Shape::Capsule { .. } => "capsule",
+            Shape::Cylinder { .. } => "cylinder",
+            Shape::ConvexHull(_) => "convex_hull",
+            Shape::Compound(_) => "compound",
+            Shape::Plane { .. } => "plane",
+            Shape::TriMesh(_) => "trimesh",
+            Shape::HeightField(_) => "heightfield",
+        }
+    }
+
+    /// A plane with outward normal `normal` at `offset` along it.
+    pub fn plane(normal: Vec3, offset: Real) -> Shape {
+        Shape::Plane { normal, offset }
+    }
+
+    /// True for shapes without a finite volume or mass (plane, mesh, height field), which
+    /// only static bodies may have.
+    pub fn is_static_only(&self) -> bool {
+        matches!(
+            self,
+            Shape::Plane { .. } | Shape::TriMesh(_) | Shape::HeightField(_)
+        )
+    }
+
+    /// Checks sizes and nesting; field paths are relative to the shape itself.
+    pub fn validate(&self) -> Result<()> {
+        match self {
+            Shape::Sphere { radius } => check::positive("radius", *radius),
+            Shape::Box { half_extents } => check::positive_vec3("half_extents", *half_extents),
+            Shape::Capsule {
+                radius,
+                half_height,
+            } => {
+                check::positive("radius", *radius)?;
+                check::non_negative("half_height", *half_height)
+            }
+            Shape::Cylinder {
+                radius,
+                half_height,
+            } => {
+                check::positive("radius", *radius)?;
+                check::positive("half_height", *half_height)
+            }
+            // Hulls, meshes and height fields are validated when built.
+            Shape::ConvexHull(_) | Shape::TriMesh(_) | Shape::HeightField(_) => Ok(()),
+            Shape::Plane { normal, offset } => {
+                check::vec3("normal", *normal)?;
+                if normal.length() < 1e-6 {
+                    return Err(Error::invalid("normal", "must be a non-zero vector"));
+                }
+                check::finite("offset", *offset)
+            }
+            Shape::Compound(children) => {
+                if children.is_empty() {
+                    return Err(Error::invalid("children", "must not be empty"));
+                }
+                for (i, child) in children.iter().enumerate() {
+                    let at = format!("children[{i}]");
+                    if child.shape.is_static_only() {
+                        return Err(Error::invalid(
+                            format!("{at}.shape.type"),
+                            "planes, meshes and height fields cannot be compound children",
+                        ));
+                    }
+                    child
+                        .shape
+                        .validate()
+                        .map_err(|e| e.within(&format!("{at}.shape")))?;
+                    check::vec3("position", child.position).map_err(|e| e.within(&at))?;
+                    check::rotation("orientation", child.orientation).map_err(|e| e.within(&at))?;
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// Mass, centre of mass and inertia tensor (about the centre of mass, in the shape's
+    /// frame) for a uniform `density` (kg/m³). The shape must be valid. Static-only shapes
+    /// have no volume; they report a unit placeholder that nothing integrates.
+    pub fn mass_properties(&self, density: Real) -> MassProperties {
+        match self {
+            Shape::Sphere { radius } => MassProperties::sphere(density, *radius),
+            Shape::Box { half_extents } => MassProperties::cuboid(density, *half_extents),
+            Shape::Capsule {
+                radius,
+                half_height,
+            } => MassProperties::capsule(density, *radius, *half_height),
+            Shape::Cylinder {
+                radius,
+                half_height,
+            } => MassProperties::cylinder(density, *radius, *half_height),
+            Shape::ConvexHull(hull) => hull.mass_properties(density),
+            Shape::Plane { .. } | Shape::TriMesh(_) | Shape::HeightField(_) => {
+                MassProperties::diagonal(1.0, Vec3::ONE)
+            }
+            Shape::Compound(children) => MassProperties::sum(children.iter().map(|c| {
+                c.shape
+                    .mass_properties(density)
+                    .transformed(c.position, c.orientation.normalize())
+            })),
+        }
+    }
+
+    /// Volume (m³).
+    pub fn volume(&self) -> Real {
+        self.mass_properties(1.0).mass
+    }
+
+    /// The radius of the smallest sphere about the shape's origin that holds the shape;
+    /// used for automatic cameras and, later, bounding volumes.
+    pub fn bounding_radius(&self) -> Real {
+        match self {
+            Shape::Sphere { radius } => *radius,
+            Shape::Box { half_extents } => half_extents.length(),
+            Shape::Capsule {
+                radius,
+                half_height,
+            } => radius + half_height,
+            Shape::Cylinder {
+                radius,
+                half_height,
+            } => (radius * radius + half_height * half_height).sqrt(),
+            Shape::ConvexHull(hull) => hull
+                .vertices()
+                .iter()
+                .map(|v| v.length())
+                .fold(0.0, Real::max),
+            Shape::Compound(children) => children
+                .iter()
+                .map(|c| c.position.length() + c.shape.bounding_radius())
+                .fold(0.0, Real::max),
+            Shape::Plane { .. } => Real::INFINITY,
+            Shape::TriMesh(m) => m.vertices().iter().map(|v| v.length()).fold(0.0, Real::max),
+            Shape::HeightField(h) => {
+                let b = h.local_aabb();
+                b.min.length().max(b.max.length())
+            }
+        }
+    }
+}

@@ -1,0 +1,533 @@
+//! Bodies: their definition (what a user fills in) and their state (what the integrators
+//! advance).
+//!
+//! The state is the seed's: centre-of-mass position x, orientation q, linear momentum
+//! p = m v (kept as v, the same thing scaled) and angular momentum L. The angular velocity
+//! is derived, ω = I_world⁻¹ L with I_world = R I_body Rᵀ, because L, not ω, is what a
+//! torque-free body conserves.
+
+use crate::collision::shape::{MassProperties, Shape};
+use crate::error::{check, Error, Result};
+use crate::math::{Mat3, Quat, Real, Vec3};
+
+/// How a body moves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BodyKind {
+    /// Never moves; infinite mass.
+    Static,
+    /// Moves with the velocity it is given, unaffected by forces; infinite mass.
+    Kinematic,
+    /// Moves under forces.
+    #[default]
+    Dynamic,
+}
+
+impl BodyKind {
+    /// The kind named as in scene files: `static`, `kinematic` or `dynamic`.
+    pub fn from_name(name: &str) -> Option<BodyKind> {
+        match name {
+            "static" => Some(BodyKind::Static),
+            "kinematic" => Some(BodyKind::Kinematic),
+            "dynamic" => Some(BodyKind::Dynamic),
+            _ => None,
+        }
+    }
+}
+
+/// Where a body's mass comes from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MassSpec {
+    /// Uniform density (kg/m³) over the shape's volume.
+    Density(Real),
+    /// Total mass (kg), spread uniformly over the shape.
+    Mass(Real),
+}
+
+impl Default for MassSpec {
+    /// Water: 1000 kg/m³.
+    fn default() -> Self {
+        MassSpec::Density(1000.0)
+    }
+}
+
+/// A user-given inertia tensor about the centre of mass, in body axes (kg·m²).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum InertiaSpec {
+    /// Principal moments along the body's x, y, z axes.
+    Principal(Vec3),
+    /// A full symmetric tensor.
+    Tensor(Mat3),
+}
+
+/// Everything needed to create a body; `Default` gives a resting dynamic body at the
+/// origin with the density of water.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BodyDef {
+    /// Optional unique name (scene files refer to bodies by name).
+    pub name: Option<String>,
+    /// Static, kinematic or dynamic.
+    pub kind: BodyKind,
+    /// World position of the body's frame, the frame the shape is defined in (m).
+    pub position: Vec3,
+    /// Orientation of the body's frame, [x, y, z, w]; normalised on creation.
+    pub orientation: Quat,
+    /// World velocity of the centre of mass (m/s).
+    pub linear_velocity: Vec3,
+    /// World angular velocity (rad/s).
+    pub angular_velocity: Vec3,
+    /// Density or total mass.
+    pub mass: MassSpec,
+    /// Overrides the inertia computed from the shape (about the centre of mass).
+    pub inertia: Option<InertiaSpec>,
+    /// Overrides the centre of mass computed from the shape (body frame, m).
+    pub center_of_mass: Option<Vec3>,
+    /// Restricts the body to the XY plane, turning only about z (the seed's 2D dynamics).
+    pub planar: bool,
+    /// Collision layers the body is in (bits); default layer 1.
+    pub collision_group: u32,
+    /// Layers it collides with (bits); two bodies collide when each one's group meets the
+    /// other's mask. Default: all.
+    pub collision_mask: u32,
+    /// Coulomb friction coefficient (dimensionless); a pair uses √(μ_a μ_b). Default 0.6.
+    pub friction: Real,
+    /// Coefficient of restitution in [0, 1]; a pair uses the larger. Default 0.
+    pub restitution: Real,
+    /// Continuous collision against every body, not only static ones, for fast projectiles.
+    pub bullet: bool,
+}
+
+impl Default for BodyDef {
+    fn default() -> Self {
+        BodyDef {
+            name: None,
+            kind: BodyKind::Dynamic,
+            position: Vec3::ZERO,
+            orientation: Quat::IDENTITY,
+            linear_velocity: Vec3::ZERO,
+            angular_velocity: Vec3::ZERO,
+            mass: MassSpec::default(),
+            inertia: None,
+            center_of_mass: None,
+            planar: false,
+            collision_group: 1,
+            collision_mask: u32::MAX,
+            friction: 0.6,
+            restitution: 0.0,
+            bullet: false,
+        }
+    }
+}
+
+/// A body in a world: its fixed properties and its current state.
+#[derive(Debug, Clone)]
+pub struct Body {
+    pub(crate) name: Option<String>,
+    pub(crate) kind: BodyKind,
+    pub(crate) shape: Shape,
+    pub(crate) planar: bool,
+    pub(crate) filter: crate::collision::broad_phase::Filter,
+    pub(crate) friction: Real,
+    pub(crate) restitution: Real,
+    pub(crate) bullet: bool,
+    /// Half the body's thinnest extent: moving farther in a step makes it a CCD candidate.
+    pub(crate) ccd_extent: Real,
+    /// False while the body's island sleeps.
+    pub(crate) awake: bool,
+    /// How long the body has been below the sleep thresholds (s).
+    pub(crate) sleep_time: Real,
+    /// The sleeping island the body belongs to.
+    pub(crate) island_tag: u32,
+    // Mass properties (dynamic bodies; zero inverse mass otherwise).
+    pub(crate) mass: Real,
+    pub(crate) inv_mass: Real,
+    pub(crate) local_center: Vec3,
+    pub(crate) inertia_local: Mat3,
+    pub(crate) inv_inertia_local: Mat3,
+    /// Principal moments and the body-frame unit axes they belong to (columns, det +1).
+    pub(crate) principal_moments: Vec3,
+    pub(crate) principal_axes: Mat3,
+    /// The same axes as a rotation from the principal frame to the body frame.
+    pub(crate) principal_rotation: Quat,
+    /// All principal moments equal (spheres, cubes): the inertia tensor is a multiple
+    /// of the identity in every frame.
+    pub(crate) isotropic: bool,
+    /// For planar bodies, I_zz of the world tensor, constant under rotations about z.
+    pub(crate) planar_inertia: Real,
+    // State.
+    pub(crate) com: Vec3,
+    pub(crate) orientation: Quat,
+    pub(crate) velocity: Vec3,
+    pub(crate) angular_momentum: Vec3,
+    /// Derived from L for dynamic bodies; prescribed for kinematic ones.
+    pub(crate) angular_velocity: Vec3,
+}
+
+impl Body {
+    pub(crate) fn new(def: &BodyDef, shape: Shape) -> Result<Body> {
+        validate_def(def)?;
+        shape.validate().map_err(|e| e.within("shape"))?;
+        if shape.is_static_only() && def.kind != BodyKind::Static {
+            return Err(Error::invalid(
+                "kind",
+                format!("a {} shape needs a static body", shape.kind_name()),
+            ));
+        }
+        let shape = normalise_plane(shape);
+        let orientation = check::rotation("orientation", def.orientation)?;
+        let props = mass_properties(def, &shape)?;
+        let (moments, axes) = crate::math::symmetric_eigen(props.inertia);
+        let dynamic = def.kind == BodyKind::Dynamic;
+        let mut body = Body {
+            name: def.name.clone(),
+            kind: def.kind,
+            shape,
+            planar: def.planar,
+            filter: crate::collision::broad_phase::Filter {
+                group: def.collision_group,
+                mask: def.collision_mask,
+            },
+            friction: def.friction,
+            restitution: def.restitution,
+            bullet: def.bullet,
+            ccd_extent: 0.0,
+            awake: true,
+            sleep_time: 0.0,
+            island_tag: 0,
+            mass: props.mass,
+            inv_mass: if dynamic { 1.0 / props.mass } else { 0.0 },
+            local_center: props.center,
+            inertia_local: props.inertia,
+            inv_inertia_local: axes * Mat3::from_diagonal(moments.recip()) * axes.transpose(),
+            principal_moments: moments,
+            principal_axes: axes,
+            principal_rotation: Quat::from_mat3(&axes).normalize(),
+            isotropic: moments.max_element() - moments.min_element()
+                <= 1e-12 * moments.max_element(),
+            planar_inertia: 0.0,
+            com: def.position + orientation * props.center,
+            orientation,
+            velocity: def.linear_velocity,
+            angular_momentum: Vec3::ZERO,
+            angular_velocity: def.angular_velocity,
+        };
+        body.ccd_extent = ccd_extent(&body.shape);
+        let r = Mat3::from_quat(orientation);
+        body.planar_inertia = (r * props.inertia * r.transpose()).z_axis.z;
+        if body.planar {
+            body.velocity.z = 0.0;
+            body.angular_velocity = Vec3::new(0.0, 0.0, body.angular_velocity.z);
+        }
+        body.set_angular_velocity_internal(body.angular_velocity);
+        Ok(body)
+    }
+
+    /// The body's name, if it has one.
+    pub fn name(&self) -> Option<&str> {
+        self.name.as_deref()
+    }
+    /// Static, kinematic or dynamic.
+    pub fn kind(&self) -> BodyKind {
+        self.kind
+    }
+    /// The shape, in the body frame.
+    pub fn shape(&self) -> &Shape {
+        &self.shape
+    }
+    /// The body's frame as a pose (origin and orientation), which its shape is placed by.
+    pub fn pose(&self) -> crate::collision::geometry::Pose {
+        crate::collision::geometry::Pose::new(self.position(), self.orientation)
+    }
+    /// False while the body's island sleeps.
+    pub fn is_awake(&self) -> bool {
+        self.awake
+    }
+    /// Friction coefficient.
+    pub fn friction(&self) -> Real {
+        self.friction
+    }
+    /// Coefficient of restitution.
+    pub fn restitution(&self) -> Real {
+        self.restitution
+    }
+    /// Collision layers (group) and the layers it collides with (mask).
+    pub fn collision_filter(&self) -> (u32, u32) {
+        (self.filter.group, self.filter.mask)
+    }
+    /// Whether the body is confined to the XY plane.
+    pub fn is_planar(&self) -> bool {
+        self.planar
+    }
+    /// Mass (kg); for static and kinematic bodies the mass their shape would have.
+    pub fn mass(&self) -> Real {
+        self.mass
+    }
+    /// Centre of mass in the body frame (m).
+    pub fn local_center_of_mass(&self) -> Vec3 {
+        self.local_center
+    }
+    /// Inertia tensor about the centre of mass, body axes (kg·m²).
+    pub fn inertia_local(&self) -> Mat3 {
+        self.inertia_local
+    }
+    /// Principal moments of inertia (kg·m²) and their axes (columns, body frame).
+    pub fn principal_inertia(&self) -> (Vec3, Mat3) {
+        (self.principal_moments, self.principal_axes)
+    }
+    /// Inertia tensor in world axes, R I_body Rᵀ (kg·m²).
+    pub fn inertia_world(&self) -> Mat3 {
+        let r = Mat3::from_quat(self.orientation);
+        r * self.inertia_local * r.transpose()
+    }
+    /// World position of the body frame's origin (m).
+    pub fn position(&self) -> Vec3 {
+        self.com - self.orientation * self.local_center
+    }
+    /// World position of the centre of mass (m).
+    pub fn center_of_mass(&self) -> Vec3 {
+        self.com
+    }
+    /// Orientation, body frame to world.
+    pub fn orientation(&self) -> Quat {
+        self.orientation
+    }
+    /// Velocity of the centre of mass (m/s).
+    pub fn linear_velocity(&self) -> Vec3 {
+        self.velocity
+    }
+    /// Angular velocity, world frame (rad/s).
+    pub fn angular_velocity(&self) -> Vec3 {
+        self.angular_velocity
+    }
+    /// Linear momentum p = m v (kg·m/s); zero for non-dynamic bodies.
+    pub fn linear_momentum(&self) -> Vec3 {
+        if self.kind == BodyKind::Dynamic {
+            self.velocity * self.mass
+        } else {
+            Vec3::ZERO
+        }
+    }
+    /// Angular momentum about the centre of mass, world frame (kg·m²/s).
+    pub fn angular_momentum(&self) -> Vec3 {
+        self.angular_momentum
+    }
+    /// Velocity of a world point moving with the body: v + ω × (p − x).
+    pub fn velocity_at_point(&self, world_point: Vec3) -> Vec3 {
+        self.velocity + self.angular_velocity.cross(world_point - self.com)
+    }
+    /// Kinetic energy ½ m v² + ½ ω·L (J); zero for non-dynamic bodies.
+    pub fn kinetic_energy(&self) -> Real {
+        if self.kind != BodyKind::Dynamic {
+            return 0.0;
+        }
+        0.5 * self.mass * self.velocity.length_squared()
+            + 0.5 * self.angular_velocity.dot(self.angular_momentum)
+    }
+
+    /// ω from L for this body at orientation `q`: ω = R I⁻¹ Rᵀ L, or for a planar body
+    /// the seed's 2D rule ω_z = L_z / I_zz.
+    #[inline]
+    pub(crate) fn omega_from_momentum(&self, q: Quat, l: Vec3) -> Vec3 {
+        if self.planar {
+            Vec3::new(0.0, 0.0, l.z / self.planar_inertia)
+        } else {
+            q * (self.inv_inertia_local * (q.inverse() * l))
+        }
+    }
+
+    /// L = I_world ω (with the planar rule for planar bodies).
+    pub(crate) fn momentum_from_omega(&self, q: Quat, w: Vec3) -> Vec3 {
+        if self.planar {
+            Vec3::new(0.0, 0.0, w.z * self.planar_inertia)
+        } else {
+            q * (self.inertia_local * (q.inverse() * w))
+        }
+    }
+
+    pub(crate) fn set_angular_velocity_internal(&mut self, w: Vec3) {
+        let w = if self.planar {
+            Vec3::new(0.0, 0.0, w.z)
+        } else {
+            w
+        };
+        if self.kind == BodyKind::Dynamic {
+            self.angular_momentum = self.momentum_from_omega(self.orientation, w);
+            self.angular_velocity =
+                self.omega_from_momentum(self.orientation, self.angular_momentum);
+        } else {
+            self.angular_momentum = Vec3::ZERO;
+            self.angular_velocity = if self.kind == BodyKind::Static {
+                Vec3::ZERO
+            } else {
+                w
+            };
+        }
+    }
+}
+
+fn validate_def(def: &BodyDef) -> Result<()> {
+    check::vec3("position", def.position)?;
+    check::vec3("velocity", def.linear_velocity)?;
+    check::vec3("angular_velocity", def.angular_velocity)?;
+    if let Some(c) = def.center_of_mass {
+        check::vec3("center_of_mass", c)?;
+    }
+    check::non_negative("friction", def.friction)?;
+    check::non_negative("restitution", def.restitution)?;
+    if def.restitution > 1.0 {
+        return Err(Error::invalid("restitution", "must be <= 1"));
+    }
+    match def.mass {
+        MassSpec::Density(d) => check::positive("density", d),
+        MassSpec::Mass(m) => check::positive("mass", m),
+    }
+}
+
+/// Planes are stored with a unit normal so every routine can rely on it.
+fn normalise_plane(shape: Shape) -> Shape {
+    match shape {
+        Shape::Plane { normal, offset } => {
+            let len = normal.length();
+            Shape::Plane {
+                normal: normal / len,
+                offset: offset / len,
+            }
+        }
+        other => other,
+    }
+}
+
+/// Mass properties from the shape and the def's density or mass, then the overrides.
+fn mass_properties(def: &BodyDef, shape: &Shape) -> Result<MassProperties> {
+    if shape.is_static_only() {
+        return Ok(shape.mass_properties(1.0));
+    }
+    let mut props = match def.mass {
+        MassSpec::Density(d) => shape.mass_properties(d),
+        MassSpec::Mass(m) => shape.mass_properties(1.0).with_mass(m),
+    };
+    if let Some(c) = def.center_of_mass {
+        props.center = c;
+    }
+    if let Some(spec) = def.inertia {
+        props.inertia = validate_inertia(spec)?;
+    }
+    check_mass_came_out(def, shape, &props)?;
+    Ok(props)
+}
+
+/// Valid sizes can still multiply out to nothing or to infinity (a 1e-120 m sphere has no
+/// volume in floating point, 1e308 kg/m³ times a litre overflows); such a body would
+/// turn NaN on its first step. The error names the factor that is out of range.
+fn check_mass_came_out(def: &BodyDef, shape: &Shape, props: &MassProperties) -> Result<()> {
+    let good = |x: Real| x.is_finite() && x > 0.0;
+    let (moments, _) = crate::math::symmetric_eigen(props.inertia);
+    if good(props.mass) && good(moments.x) && good(moments.y) && good(moments.z) {
+        return Ok(());
+    }
+    let unit = shape.mass_properties(1.0);
+    let (unit_moments, _) = crate::math::symmetric_eigen(unit.inertia);
+    let field = if !good(unit.mass)
+        || !good(unit_moments.min_element())
+        || !good(unit_moments.max_element())
+    {
+        "shape"
+    } else {
+        match def.mass {
+            MassSpec::Density(_) => "density",
+            MassSpec::Mass(_) => "mass",
+        }
+    };
+    Err(Error::invalid(
+        field,
+        format!(
+            "mass and inertia come out zero or infinite at this size ({} kg, principal moments [{}, {}, {}] kg·m²)",
+            props.mass, moments.x, moments.y, moments.z
+        ),
+    ))
+}
+
+/// A tensor must be symmetric, positive definite and physically possible: no principal
+/// moment may exceed the sum of the other two (the triangle inequality every real mass
+/// distribution satisfies).
+pub(crate) fn validate_inertia(spec: InertiaSpec) -> Result<Mat3> {
+    let m = match spec {
+        InertiaSpec::Principal(d) => {
+            check::positive_vec3("inertia", d)?;
+            Mat3::from_diagonal(d)
+        }
+        InertiaSpec::Tensor(m) => {
+            let cols = [m.x_axis, m.y_axis, m.z_axis];
+            if cols.iter().any(|c| !crate::math::vec3_is_finite(*c)) {
+                return Err(Error::invalid("inertia", "must be finite numbers"));
+            }
+            let scale = cols
+                .iter()
+                .map(|c| c.abs().max_element())
+                .fold(0.0, Real::max);
+            let asym = (m - m.transpose())
+                .to_cols_array()
+                .iter()
+                .fold(0.0 as Real, |a, b| a.max(b.abs()));
+            if asym > 1e-9 * scale.max(crate::math::EPSILON) {
+                return Err(Error::invalid("inertia", "must be a symmetric 3x3 matrix"));
+            }
+            m
+        }
+    };
+    let (moments, _) = crate::math::symmetric_eigen(m);
+    if moments.min_element() <= 0.0 {
+        return Err(Error::invalid("inertia", "must be positive definite"));
+    }
+    let sum = moments.x + moments.y + moments.z;
+    let slack = 1e-9 * sum;
+    let largest = moments.max_element();
+    if largest > sum - largest + slack {
+        return Err(Error::invalid(
+            "inertia",
+            "violates the triangle inequality: no principal moment may exceed the sum of the other two",
+        ));
+    }
+    Ok(m)
+}
+
+/// One body's dynamic state at some time (a step's start, or an integrator's stage).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Motion {
+    /// Centre of mass (m).
+    pub x: Vec3,
+    /// Orientation.
+    pub q: Quat,
+    /// Velocity of the centre of mass (m/s).
+    pub v: Vec3,
+    /// Angular momentum about the centre of mass (kg·m²/s).
+    pub l: Vec3,
+    /// Angular velocity (rad/s): derived from `l` for dynamic bodies.
+    pub w: Vec3,
+}
+
+impl Motion {
+    pub(crate) fn of(body: &Body) -> Motion {
+        Motion {
+            x: body.com,
+            q: body.orientation,
+            v: body.velocity,
+            l: body.angular_momentum,
+            w: body.angular_velocity,
+        }
+    }
+}
+
+/// The thickness below which a step's travel counts as fast: half the smallest extent of
+/// the shape's bounding box, or of its thinnest compound child.
+fn ccd_extent(shape: &Shape) -> Real {
+    match shape {
+        Shape::Compound(children) => children
+            .iter()
+            .map(|c| ccd_extent(&c.shape))
+            .fold(Real::INFINITY, Real::min),
+        _ => shape
+            .aabb(&crate::collision::geometry::Pose::IDENTITY)
+            .half_extents()
+            .min_element(),
+    }
+}

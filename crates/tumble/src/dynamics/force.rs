@@ -1,0 +1,324 @@
+//! Force elements: gravity, springs, dampers, drag, applied forces and user callbacks.
+//!
+//! Every element is a function of the state (positions, orientations, velocities), so the
+//! multi-stage integrators can evaluate it at their intermediate states. Forces are world
+//! frame (N), torques world frame about the centre of mass (N·m).
+
+use crate::dynamics::body::Motion;
+use crate::dynamics::body::{Body, BodyKind};
+use crate::error::{check, Result};
+use crate::id::BodyId;
+use crate::math::{Real, Vec3};
+
+/// Force and torque on one body (world frame, torque about the centre of mass).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Wrench {
+    /// Net force (N).
+    pub force: Vec3,
+    /// Net torque about the centre of mass (N·m).
+    pub torque: Vec3,
+}
+
+/// The far end of a spring.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SpringEnd {
+    /// A fixed world point (m).
+    World(Vec3),
+    /// A point on another body, in that body's frame (m).
+    Body {
+        /// The other body.
+        body: BodyId,
+        /// The anchor in the other body's frame (m).
+        anchor: Vec3,
+    },
+}
+
+/// A Hookean spring with a parallel damper between `anchor` on `body` and `other`:
+/// F = −k (l − l₀) û − b (v_rel·û) û on `body`, the opposite on the other end.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spring {
+    /// The body the spring starts on.
+    pub body: BodyId,
+    /// Anchor in `body`'s frame (m).
+    pub anchor: Vec3,
+    /// Where the spring ends.
+    pub other: SpringEnd,
+    /// Stiffness k (N/m).
+    pub stiffness: Real,
+    /// Rest length l₀ (m).
+    pub rest_length: Real,
+    /// Damping b along the spring (N·s/m).
+    pub damping: Real,
+}
+
+/// Air drag at the centre of mass: F = −c₁ v − c₂ |v| v.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Drag {
+    /// The body.
+    pub body: BodyId,
+    /// Linear coefficient c₁ (N·s/m).
+    pub linear: Real,
+    /// Quadratic coefficient c₂ (N·s²/m²).
+    pub quadratic: Real,
+}
+
+/// A constant force at a point of the body, plus a constant torque.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AppliedForce {
+    /// The body.
+    pub body: BodyId,
+    /// Force, world frame (N).
+    pub force: Vec3,
+    /// Where it acts, body frame (m); `None` is the centre of mass. Off the centre it
+    /// also turns the body: τ = r × F.
+    pub point: Option<Vec3>,
+    /// Extra torque, world frame (N·m).
+    pub torque: Vec3,
+}
+
+/// One force element.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Force {
+    /// Spring and damper.
+    Spring(Spring),
+    /// Drag.
+    Drag(Drag),
+    /// Constant force and torque.
+    Applied(AppliedForce),
+}
+
+impl Force {
+    pub(crate) fn validate(&self) -> Result<()> {
+        match self {
+            Force::Spring(s) => {
+                check::vec3("anchor", s.anchor)?;
+                match s.other {
+                    SpringEnd::World(p) => check::vec3("world_point", p)?,
+                    SpringEnd::Body { anchor, .. } => check::vec3("other_anchor", anchor)?,
+                }
+                check::non_negative("stiffness", s.stiffness)?;
+                check::non_negative("rest_length", s.rest_length)?;
+                check::non_negative("damping", s.damping)
+            }
+            Force::Drag(d) => {
+                check::non_negative("linear", d.linear)?;
+                check::non_negative("quadratic", d.quadratic)
+            }
+            Force::Applied(a) => {
+                check::vec3("force", a.force)?;
+                if let Some(p) = a.point {
+                    check::vec3("point", p)?;
+                }
+                check::vec3("torque", a.torque)
+            }
+        }
+    }
+
+    /// The bodies this element acts on.
+    pub fn bodies(&self) -> (BodyId, Option<BodyId>) {
+        match self {
+            Force::Spring(s) => match s.other {
+                SpringEnd::World(_) => (s.body, None),
+                SpringEnd::Body { body, .. } => (s.body, Some(body)),
+            },
+            Force::Drag(d) => (d.body, None),
+            Force::Applied(a) => (a.body, None),
+        }
+    }
+}
+
+/// A user force: called at every force evaluation (several times per step for
+/// multi-stage integrators) with the state being evaluated.
+pub type ForceCallback = Box<dyn FnMut(&mut ForceContext<'_>) + Send>;
+
+/// What a [`ForceCallback`] sees and where it writes.
+pub struct ForceContext<'a> {
+    pub(crate) time: Real,
+    pub(crate) bodies: &'a [Body],
+    pub(crate) motions: &'a [Motion],
+    pub(crate) lookup: &'a dyn Fn(BodyId) -> Option<usize>,
+    pub(crate) out: &'a mut [Wrench],
+}
+
+impl ForceContext<'_> {
+    /// Simulation time of the state being evaluated (s).
+    pub fn time(&self) -> Real {
+        self.time
+    }
+    /// Centre-of-mass position of `body` in this state (m).
+    pub fn position(&self, body: BodyId) -> Option<Vec3> {
+        (self.lookup)(body).map(|i| self.motions[i].x)
+    }
+    /// Centre-of-mass velocity of `body` in this state (m/s).
+    pub fn velocity(&self, body: BodyId) -> Option<Vec3> {
+        (self.lookup)(body).map(|i| self.motions[i].v)
+    }
+    /// Angular velocity of `body` in this state (rad/s).
+    pub fn angular_velocity(&self, body: BodyId) -> Option<Vec3> {
+        (self.lookup)(body).map(|i| self.motions[i].w)
+    }
+    /// Orientation of `body` in this state.
+    pub fn orientation(&self, body: BodyId) -> Option<crate::math::Quat> {
+        (self.lookup)(body).map(|i| self.motions[i].q)
+    }
+    /// Mass of `body` (kg).
+    pub fn mass(&self, body: BodyId) -> Option<Real> {
+        (self.lookup)(body).map(|i| self.bodies[i].mass)
+    }
+    /// Adds a force at the centre of mass. Returns false for an unknown body.
+    pub fn add_force(&mut self, body: BodyId, force: Vec3) -> bool {
+        self.add_wrench(body, force, Vec3::ZERO)
+    }
+    /// Adds a force acting at a world point; it also adds the torque (p − x) × F.
+    pub fn add_force_at_point(&mut self, body: BodyId, force: Vec3, world_point: Vec3) -> bool {
+        match (self.lookup)(body) {
+            Some(i) => {
+                let r = world_point - self.motions[i].x;
+                self.out[i].force += force;
+                self.out[i].torque += r.cross(force);
+                true
+            }
+            None => false,
+        }
+    }
+    /// Adds a torque (N·m).
+    pub fn add_torque(&mut self, body: BodyId, torque: Vec3) -> bool {
+        self.add_wrench(body, Vec3::ZERO, torque)
+    }
+    fn add_wrench(&mut self, body: BodyId, force: Vec3, torque: Vec3) -> bool {
+        match (self.lookup)(body) {
+            Some(i) => {
+                self.out[i].force += force;
+                self.out[i].torque += torque;
+                true
+            }
+            None => false,
+        }
+    }
+}
+
+/// A spring with its ends resolved to dense body indices and world anchor offsets for
+/// one state: the quantities both the force and its Jacobian need.
+pub(crate) struct SpringGeometry {
+    pub a: usize,
+    pub b: Option<usize>,
+    /// Anchor offsets from the centres of mass, world frame.
+    pub ra: Vec3,
+    pub rb: Vec3,
+    /// From the anchor on `a` to the other end.
+    pub d: Vec3,
+    /// Velocity of the other end relative to the anchor on `a`.
+    pub dv: Vec3,
+}
+
+impl SpringGeometry {
+    pub fn new(
+        s: &Spring,
+        bodies: &[Body],
+        motions: &[Motion],
+        lookup: &dyn Fn(BodyId) -> Option<usize>,
+    ) -> Option<SpringGeometry> {
+        let a = lookup(s.body)?;
+        let ma = &motions[a];
+        let ra = ma.q * (s.anchor - bodies[a].local_center);
+        let pa = ma.x + ra;
+        let va = ma.v + ma.w.cross(ra);
+        let (b, rb, pb, vb) = match s.other {
+            SpringEnd::World(p) => (None, Vec3::ZERO, p, Vec3::ZERO),
+            SpringEnd::Body { body, anchor } => {
+                let b = lookup(body)?;
+                let mb = &motions[b];
+                let rb = mb.q * (anchor - bodies[b].local_center);
+                (Some(b), rb, mb.x + rb, mb.v + mb.w.cross(rb))
+            }
+        };
+        Some(SpringGeometry {
+            a,
+            b,
+            ra,
+            rb,
+            d: pb - pa,
+            dv: vb - va,
+        })
+    }
+
+    /// Force on body `a` (the opposite acts on `b`).
+    pub fn force(&self, s: &Spring) -> Vec3 {
+        let len = self.d.length();
+        if len <= Real::EPSILON * (1.0 + s.rest_length) {
+            // Coincident ends: the direction is undefined and, with l₀ > 0, so is the
+            // push; no force is the only choice that cannot inject energy.
+            return Vec3::ZERO;
+        }
+        let u = self.d / len;
+        u * (s.stiffness * (len - s.rest_length) + s.damping * self.dv.dot(u))
+    }
+}
+
+/// Adds gravity and every force element, evaluated at `motions`, into `out`.
+pub(crate) fn accumulate(
+    gravity: Vec3,
+    forces: &[Force],
+    bodies: &[Body],
+    motions: &[Motion],
+    lookup: &dyn Fn(BodyId) -> Option<usize>,
+    out: &mut [Wrench],
+) {
+    for ((w, body), _m) in out.iter_mut().zip(bodies).zip(motions) {
+        *w = Wrench {
+            force: if body.kind == BodyKind::Dynamic {
+                gravity * body.mass
+            } else {
+                Vec3::ZERO
+            },
+            torque: Vec3::ZERO,
+        };
+    }
+    for f in forces {
+        match f {
+            Force::Spring(s) => {
+                let Some(g) = SpringGeometry::new(s, bodies, motions, lookup) else {
+                    continue;
+                };
+                let fa = g.force(s);
+                out[g.a].force += fa;
+                out[g.a].torque += g.ra.cross(fa);
+                if let Some(b) = g.b {
+                    out[b].force -= fa;
+                    out[b].torque -= g.rb.cross(fa);
+                }
+            }
+            Force::Drag(d) => {
+                let Some(i) = lookup(d.body) else { continue };
+                let v = motions[i].v;
+                out[i].force -= v * (d.linear + d.quadratic * v.length());
+            }
+            Force::Applied(a) => {
+                let Some(i) = lookup(a.body) else { continue };
+                out[i].force += a.force;
+                out[i].torque += a.torque;
+                if let Some(p) = a.point {
+                    let r = motions[i].q * (p - bodies[i].local_center);
+                    out[i].torque += r.cross(a.force);
+                }
+            }
+        }
+    }
+}
+
+/// Potential energy stored in the springs (J): Σ ½ k (l − l₀)².
+pub(crate) fn spring_potential(
+    forces: &[Force],
+    bodies: &[Body],
+    motions: &[Motion],
+    lookup: &dyn Fn(BodyId) -> Option<usize>,
+) -> Real {
+    forces
+        .iter()
+        .filter_map(|f| match f {
+            Force::Spring(s) => SpringGeometry::new(s, bodies, motions, lookup)
+                .map(|g| 0.5 * s.stiffness * (g.d.length() - s.rest_length).powi(2)),
+            _ => None,
+        })
+        .sum()
+}

@@ -1,0 +1,152 @@
+//! The step's one representation of a body, split as in Box2D v3: a small `BodyState`
+//! that every constraint pass reads and writes (velocities and the motion since the step
+//! began), and a `BodySim` with what changes only between substeps.
+//!
+//! Every body of the world has one of each for the whole step ([`SolverBodies`]): gathered
+//! from its `Body` once when the step begins, advanced in place by the free integrator
+//! (bodies touching nothing), the solver (bodies in contact or joined), the prescribed
+//! motion of kinematic bodies and the continuous-collision sweep, and scattered back once
+//! when the step ends. `x0`, `q0` stay the pose at the step's start throughout.
+
+use crate::dynamics::body::{Body, BodyKind, Motion};
+use crate::math::{Mat3, Quat, Real, Vec3};
+
+/// Every body of the world as the step sees it, in the world's dense order.
+#[derive(Default)]
+pub(crate) struct SolverBodies {
+    pub sims: Vec<BodySim>,
+    pub states: Vec<BodyState>,
+}
+
+impl SolverBodies {
+    /// Gathers every body at the step's start; `solved[i]` marks the bodies the solver
+    /// will move (their world inertia is needed; the others' is left zero).
+    pub fn gather(&mut self, bodies: &[Body], solved: &[bool]) {
+        self.sims.clear();
+        self.states.clear();
+        for (b, &solved) in bodies.iter().zip(solved) {
+            let (sim, state) = BodySim::new(b, solved);
+            self.sims.push(sim);
+            self.states.push(state);
+        }
+    }
+
+    /// Body `i`'s state as the integrators' ODE vector sees it.
+    pub fn motion(&self, i: usize) -> Motion {
+        let (s, st) = (&self.sims[i], &self.states[i]);
+        Motion {
+            x: s.x,
+            q: s.q,
+            v: st.v,
+            l: s.l,
+            w: st.w,
+        }
+    }
+
+    /// Sets body `i`'s state from an integrator's result.
+    pub fn set_motion(&mut self, i: usize, m: &Motion) {
+        let (s, st) = (&mut self.sims[i], &mut self.states[i]);
+        s.x = m.x;
+        s.q = m.q;
+        s.l = m.l;
+        st.v = m.v;
+        st.w = m.w;
+    }
+}
+
+/// What constraint passes touch: kept small and contiguous.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BodyState {
+    pub v: Vec3,
+    pub w: Vec3,
+    /// Displacement of the centre of mass since the step began.
+    pub dp: Vec3,
+    /// Rotation since the step began.
+    pub dr: Mat3,
+}
+
+/// The rest of a body's solver data.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BodySim {
+    pub x: Vec3,
+    pub q: Quat,
+    pub x0: Vec3,
+    pub q0: Quat,
+    /// Angular momentum, the integrated rotational state.
+    pub l: Vec3,
+    /// ω at which `l` was last brought up to date (see [`BodySim::sync_momentum`]).
+    pub w_synced: Vec3,
+    pub inv_mass: Real,
+    /// Which linear directions an impulse may change (planar bodies lose z).
+    pub linear_mask: Vec3,
+    /// World inertia and its inverse at the step's start: impulses are applied with them
+    /// for the whole step, as in Rapier and Jolt, so prepared effective masses stay valid.
+    pub inertia: Mat3,
+    pub inv_inertia: Mat3,
+    /// True for awake dynamic bodies the solver moves.
+    pub moves: bool,
+    /// The body's friction and restitution coefficients and centre of mass in its frame,
+    /// copied here so that preparing contacts, which visits bodies in no particular
+    /// order, does not fetch each one's whole `Body`.
+    pub friction: Real,
+    pub restitution: Real,
+    pub local_center: Vec3,
+}
+
+impl BodySim {
+    pub fn new(body: &Body, solved: bool) -> (BodySim, BodyState) {
+        let m = Motion::of(body);
+        let moves = solved && body.kind == BodyKind::Dynamic;
+        let (inertia, inv_inertia) = if !moves {
+            (Mat3::ZERO, Mat3::ZERO)
+        } else if body.planar {
+            let i = body.planar_inertia;
+            (
+                Mat3::from_diagonal(Vec3::new(0.0, 0.0, i)),
+                Mat3::from_diagonal(Vec3::new(0.0, 0.0, 1.0 / i)),
+            )
+        } else {
+            let r = Mat3::from_quat(m.q);
+            (
+                r * body.inertia_local * r.transpose(),
+                r * body.inv_inertia_local * r.transpose(),
+            )
+        };
+        let sim = BodySim {
+            x: m.x,
+            q: m.q,
+            x0: m.x,
+            q0: m.q,
+            l: m.l,
+            w_synced: m.w,
+            inv_mass: if moves { body.inv_mass } else { 0.0 },
+            linear_mask: if body.planar {
+                Vec3::new(1.0, 1.0, 0.0)
+            } else {
+                Vec3::ONE
+            },
+            inertia,
+            inv_inertia,
+            moves,
+            friction: body.friction,
+            restitution: body.restitution,
+            local_center: body.local_center,
+        };
+        let state = BodyState {
+            v: m.v,
+            w: m.w,
+            dp: Vec3::ZERO,
+            dr: Mat3::IDENTITY,
+        };
+        (sim, state)
+    }
+
+    /// Impulses changed ω by I₀⁻¹ ΣΔL; the same ΣΔL goes into L: ΔL = I₀ (ω − ω_synced).
+    #[inline]
+    pub fn sync_momentum(&mut self, state: &BodyState) {
+        if self.moves {
+            self.l += self.inertia * (state.w - self.w_synced);
+            self.w_synced = state.w;
+        }
+    }
+}

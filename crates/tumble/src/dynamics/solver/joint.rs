@@ -1,0 +1,364 @@
+//! Joint constraints in the soft step: what each joint's rows are, and the order and way
+//! they are solved.
+//!
+//! A joint's rows follow from its kind's description (`KindSpec` in `joint.rs`): its
+//! linear and angular locks give the hard rows, its free axis the row that limits, motor,
+//! spring and rod act on, and a `cone` option the swing-cone row (`joint_rows.rs`).
+//!
+//! Each joint is solved in the order Box2D uses (the softest first, the hard constraint
+//! last, so it has the final word): spring, motor, limits (`joint_1d.rs`), then the hard
+//! rows as one block (`joint_block.rs`). The hard rows are the joint's equalities, each a
+//! Jacobian row Ċ = lin·(v_b − v_a) + ang_b·ω_b − ang_a·ω_a, listed linear lock first,
+//! then angular lock:
+//!
+//! ```text
+//! LinearLock::Point       lin = eᵢ, ang = r × eᵢ       C = eᵢ·(p_b − p_a)
+//! LinearLock::AcrossAxis  lin = pᵢ, ang_a = (r_a + d) × pᵢ, ang_b = r_b × pᵢ
+//! AngularLock::AcrossAxis ang = bᵢ (the two directions ⊥ the axis), C = bᵢ·(h_a × h_b)
+//! AngularLock::All        ang = eᵢ, C = the rotation of q_b from q_a·q_rel
+//! ```
+//!
+//! (ball, hinge and fixed lock the point; a slider locks across its axis; a hinge locks
+//! across its axis angularly; fixed and slider lock all rotation), solved together,
+//! K = J M⁻¹ Jᵀ (up to 6×6) by Gaussian elimination. Solving the point and the lock one
+//! after the other instead leaves them fighting: a slider's across rows push at the
+//! anchor's lever arm and turn the body, the lock turns it back, and the body drifted 4 cm
+//! off a tilted axis in a second. A point lock with no angular lock (a ball joint) has no
+//! rows to couple it to and is solved apart, as a 3×3 block. Limits, motors, springs and
+//! distance rows are 1D rows. The hard rows use the joint softness (a spring at a quarter
+//! of the substep rate in the biased pass, none in the relax pass), so drift is corrected
+//! without the push-out becoming motion, as for contacts. Anchors are recomputed from the
+//! current poses every pass: a joint turns far within a step (a pendulum's anchor swings),
+//! unlike a contact.
+
+#[path = "joint_block.rs"]
+mod block;
+#[path = "joint_1d.rs"]
+mod one_d;
+#[path = "joint_rows.rs"]
+mod rows;
+
+use super::body::{BodySim, BodyState};
+use super::softness::Softness;
+use crate::dynamics::joint::{AngularLock, Joint, JointImpulses, KindSpec, LinearLock};
+use crate::math::{Mat3, Quat, Real, Vec3};
+use block::{apply_point, point_impulse, point_inverse_mass, solve_hard, solve_point};
+use one_d::{free_impulse, solve_free, solve_limit, FreeDrive};
+
+/// A body as a joint sees it: pose, inverse masses, whether it moves. The world is one
+/// that never moves, at the origin.
+#[derive(Clone, Copy)]
+struct Side {
+    x: Vec3,
+    q: Quat,
+    inv_mass: Real,
+    mask: Vec3,
+    inv_inertia: Mat3,
+    moves: bool,
+}
+
+impl Side {
+    fn of(sims: &[BodySim], k: Option<usize>) -> Side {
+        match k.map(|k| &sims[k]) {
+            Some(s) => Side {
+                x: s.x,
+                q: s.q,
+                inv_mass: s.inv_mass,
+                mask: s.linear_mask,
+                inv_inertia: s.inv_inertia,
+                moves: s.moves,
+            },
+            None => Side {
+                x: Vec3::ZERO,
+                q: Quat::IDENTITY,
+                inv_mass: 0.0,
+                mask: Vec3::ZERO,
+                inv_inertia: Mat3::ZERO,
+                moves: false,
+            },
+        }
+    }
+}
+
+/// A Jacobian row: Ċ = lin·(v_b − v_a) + ang_b·ω_b − ang_a·ω_a.
+#[derive(Clone, Copy)]
+struct Row {
+    lin: Vec3,
+    ang_a: Vec3,
+    ang_b: Vec3,
+}
+
+impl Row {
+    fn angular(axis: Vec3) -> Row {
+        Row {
+            lin: Vec3::ZERO,
+            ang_a: axis,
+            ang_b: axis,
+        }
+    }
+    fn negated(self) -> Row {
+        Row {
+            lin: -self.lin,
+            ang_a: -self.ang_a,
+            ang_b: -self.ang_b,
+        }
+    }
+    fn velocity(&self, a: &BodyState, b: &BodyState) -> Real {
+        self.lin.dot(b.v - a.v) + self.ang_b.dot(b.w) - self.ang_a.dot(a.w)
+    }
+    fn mass(&self, sa: &Side, sb: &Side) -> Real {
+        let k = sa.inv_mass * (sa.mask * self.lin).dot(self.lin)
+            + sb.inv_mass * (sb.mask * self.lin).dot(self.lin)
+            + self.ang_a.dot(sa.inv_inertia * self.ang_a)
+            + self.ang_b.dot(sb.inv_inertia * self.ang_b);
+        if k > 0.0 {
+            1.0 / k
+        } else {
+            0.0
+        }
+    }
+    fn apply(&self, lambda: Real, sa: &Side, sb: &Side, a: &mut BodyState, b: &mut BodyState) {
+        if sa.moves {
+            a.v -= sa.mask * self.lin * (sa.inv_mass * lambda);
+            a.w -= sa.inv_inertia * self.ang_a * lambda;
+        }
+        if sb.moves {
+            b.v += sb.mask * self.lin * (sb.inv_mass * lambda);
+            b.w += sb.inv_inertia * self.ang_b * lambda;
+        }
+    }
+}
+
+/// How a pass treats position error.
+#[derive(Clone, Copy)]
+pub(crate) struct JointPass {
+    /// Softness of the hard rows in this pass (rigid, no bias, in the relax pass).
+    pub soft: Softness,
+    pub bias: bool,
+    pub inv_h: Real,
+    pub h: Real,
+}
+
+/// One joint as the solver works on it.
+pub(crate) struct JointConstraint {
+    /// Index in the world's joint list.
+    pub joint: usize,
+    a: Option<usize>,
+    b: Option<usize>,
+    /// The kind's description: which rows the joint has.
+    spec: &'static KindSpec,
+    /// The swing-cone limit (rad), if the kind takes one and it is set.
+    cone: Option<Real>,
+    /// What acts on the free coordinate.
+    drive: FreeDrive,
+    /// Anchors from each centre of mass, in body frames (world frame for the world).
+    anchor_a: Vec3,
+    anchor_b: Vec3,
+    axis_a: Vec3,
+    axis_b: Vec3,
+    reference_a: Vec3,
+    reference_b: Vec3,
+    relative_rotation: Quat,
+    impulses: JointImpulses,
+    /// Impulses summed over the step's substeps: linear on b at its anchor, angular.
+    total_linear: Vec3,
+    total_angular: Vec3,
+    /// A ball joint's point block K⁻¹, from the anchors at its first solve in the substep
+    /// (`Some(None)`: K is singular there); see [`point_inverse_mass`].
+    point_mass: Option<Option<Mat3>>,
+}
+
+/// Where the geometry of a joint stands in a pass.
+struct Frame {
+    sa: Side,
+    sb: Side,
+    ra: Vec3,
+    rb: Vec3,
+    /// p_b − p_a: the anchors' separation.
+    d: Vec3,
+}
+
+impl JointConstraint {
+    /// The constraint for `joint`, with dense body indices (`None`: the world) and local
+    /// centres of mass.
+    pub fn new(index: usize, joint: &Joint, bodies: [(Option<usize>, Vec3); 2]) -> Self {
+        let [(a, center_a), (b, center_b)] = bodies;
+        let spec = joint.def.kind.spec();
+        let options = joint.def.kind.options();
+        JointConstraint {
+            joint: index,
+            a,
+            b,
+            spec,
+            cone: options.cone,
+            drive: FreeDrive::of(spec.free, &options, joint.length),
+            anchor_a: joint.def.anchor - center_a,
+            anchor_b: joint.def.other_anchor - center_b,
+            axis_a: joint.axis,
+            axis_b: joint.other_axis,
+            reference_a: joint.reference,
+            reference_b: joint.other_reference,
+            relative_rotation: joint.relative_rotation,
+            impulses: joint.impulses,
+            total_linear: Vec3::ZERO,
+            total_angular: Vec3::ZERO,
+            point_mass: None,
+        }
+    }
+
+    /// Dense indices of the two bodies (`None`: the world).
+    pub fn bodies(&self) -> [Option<usize>; 2] {
+        [self.a, self.b]
+    }
+
+    /// Whether the solver moves either body.
+    pub fn active(&self, sims: &[BodySim]) -> bool {
+        [self.a, self.b]
+            .into_iter()
+            .any(|k| k.is_some_and(|k| sims[k].moves))
+    }
+
+    fn frame(&self, sims: &[BodySim]) -> Frame {
+        let (sa, sb) = (Side::of(sims, self.a), Side::of(sims, self.b));
+        let (ra, rb) = (sa.q * self.anchor_a, sb.q * self.anchor_b);
+        Frame {
+            sa,
+            sb,
+            ra,
+            rb,
+            d: (sb.x + rb) - (sa.x + ra),
+        }
+    }
+
+    /// Runs `f` with both bodies' states; the world's is a still copy.
+    fn with_states<R>(
+        &self,
+        states: &mut [BodyState],
+        f: impl FnOnce(&mut BodyState, &mut BodyState) -> R,
+    ) -> R {
+        // Made only when needed: two of these per call cost the joint grid a tenth of its
+        // time in copies.
+        let still = || BodyState {
+            v: Vec3::ZERO,
+            w: Vec3::ZERO,
+            dp: Vec3::ZERO,
+            dr: Mat3::IDENTITY,
+        };
+        match (self.a, self.b) {
+            (Some(a), Some(b)) => match states.get_disjoint_mut([a, b]) {
+                Ok([x, y]) => f(x, y),
+                Err(_) => f(&mut still(), &mut still()),
+            },
+            (Some(a), None) => f(&mut states[a], &mut still()),
+            (None, Some(b)) => f(&mut still(), &mut states[b]),
+            (None, None) => f(&mut still(), &mut still()),
+        }
+    }
+
+    /// Applies the accumulated impulses again (every substep).
+    pub fn warm_start(&mut self, sims: &[BodySim], states: &mut [BodyState]) {
+        self.point_mass = None;
+        let fr = self.frame(sims);
+        let imp = self.impulses;
+        let hard = self.hard_rows(&fr);
+        let free = self.free_row(&fr);
+        let cone = self.cone_row(&fr);
+        let point = self.point_apart().then(|| point_impulse(&imp));
+        self.with_states(states, |a, b| {
+            if let Some(p) = point {
+                apply_point(p, &fr, a, b);
+            }
+            for (row, lambda) in hard
+                .iter()
+                .flat_map(|h| h.rows[..h.count].iter().zip(imp.hard))
+            {
+                row.apply(lambda, &fr.sa, &fr.sb, a, b);
+            }
+            if let Some((row, _)) = free {
+                row.apply(free_impulse(&imp), &fr.sa, &fr.sb, a, b);
+            }
+            if let Some((row, _)) = cone {
+                row.apply(imp.cone, &fr.sa, &fr.sb, a, b);
+            }
+        });
+    }
+
+    /// One pass over the joint's rows.
+    pub fn solve(&mut self, sims: &[BodySim], states: &mut [BodyState], pass: &JointPass) {
+        let fr = self.frame(sims);
+        let mut imp = self.impulses;
+        let drive = self.drive;
+        let free = self.free_row(&fr);
+        let cone = self.cone_row(&fr);
+        let hard = self.hard_rows(&fr);
+        let point_mass = self.point_apart().then(|| {
+            *self
+                .point_mass
+                .get_or_insert_with(|| point_inverse_mass(&fr))
+        });
+        self.with_states(states, |a, b| {
+            if let Some((row, coordinate)) = free {
+                solve_free(&drive, row, coordinate, &fr, pass, &mut imp, a, b);
+            }
+            if let Some((row, c)) = cone {
+                imp.cone = solve_limit(row, c, imp.cone, &fr, pass, a, b);
+            }
+            if let Some(hard) = &hard {
+                imp.hard = solve_hard(hard, imp.hard, &fr, pass, a, b);
+            }
+            if let Some(k_inv) = point_mass {
+                let p = solve_point(point_impulse(&imp), k_inv, &fr, pass, a, b);
+                imp.hard[..3].copy_from_slice(&p.to_array());
+            }
+        });
+        self.impulses = imp;
+    }
+
+    /// Adds the substep's impulses to the step's totals: the force on `other` at its
+    /// anchor and the pure torques.
+    pub fn add_to_totals(&mut self, sims: &[BodySim]) {
+        let imp = self.impulses;
+        if self.point_apart() && self.cone.is_none() && self.drive.is_idle() {
+            // The point's impulse is all there is, and it is already a world vector.
+            self.total_linear += point_impulse(&imp);
+            return;
+        }
+        let fr = self.frame(sims);
+        let hard = self.hard_rows(&fr);
+        let free = self.free_row(&fr).map(|(row, _)| (row, free_impulse(&imp)));
+        let cone = self.cone_row(&fr).map(|(row, _)| (row, imp.cone));
+        let rows = hard
+            .iter()
+            .flat_map(|h| h.rows[..h.count].iter().copied().zip(imp.hard));
+        for (row, lambda) in rows.chain(free).chain(cone) {
+            self.total_linear += row.lin * lambda;
+            if row.lin == Vec3::ZERO {
+                self.total_angular += row.ang_b * lambda;
+            }
+        }
+        if self.point_apart() {
+            self.total_linear += point_impulse(&imp);
+        }
+    }
+
+    /// Writes the impulses, reaction and breakage back into the joint.
+    pub fn store(&self, joint: &mut Joint, dt: Real) {
+        joint.impulses = self.impulses;
+        joint.reaction_force = self.total_linear / dt;
+        joint.reaction_torque = self.total_angular / dt;
+        if let Some(limit) = joint.def.break_force {
+            if joint.reaction_force.length() > limit {
+                joint.broken = true;
+                joint.impulses = JointImpulses::default();
+            }
+        }
+    }
+
+    /// Whether the point constraint is solved on its own, as a 3×3 block with glam: a
+    /// point lock with no angular lock (a ball joint) has no other equality rows to couple
+    /// it to (the joint grid benchmark spent a third of its time in the general
+    /// elimination).
+    fn point_apart(&self) -> bool {
+        self.spec.linear == LinearLock::Point && self.spec.angular == AngularLock::Free
+    }
+}

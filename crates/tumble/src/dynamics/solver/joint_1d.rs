@@ -1,0 +1,188 @@
+//! The joint's 1D rows: limits, motors, springs and the distance rod, each one Jacobian
+//! row J with effective mass m = 1 / (J M⁻¹ Jᵀ), solved in that order (softest first).
+//!
+//! ```text
+//! spring  soft at its own hertz/damping:   Δλ = −m·mass_scale·(Jv + bias_rate·(x − target)) − impulse_scale·λ
+//! motor   towards its speed, |λ| ≤ max_force·h:   Δλ = −m·(Jv − speed)
+//! limit   one-sided, λ ≥ 0, keeps margin ≥ 0: speculative (bias margin/h, rigid) while
+//!         the margin is positive, the joint softness once violated
+//! rod     the distance held at rest by the joint softness
+//! ```
+//!
+//! The upper limit is the lower one on the negated row. Which of these a joint has
+//! follows from its options ([`FreeDrive::of`]).
+
+use super::{Frame, JointPass, Row};
+use crate::dynamics::joint::{FreeAxis, JointImpulses, JointOptions, JointSpring, Motor};
+use crate::dynamics::solver::body::BodyState;
+use crate::dynamics::solver::softness::Softness;
+use crate::math::Real;
+
+/// A one-sided limit row: keeps `margin` ≥ 0 (speculatively while it is positive, as a
+/// contact does). Returns the new accumulated impulse (≥ 0).
+pub(super) fn solve_limit(
+    row: Row,
+    margin: Real,
+    acc: Real,
+    fr: &Frame,
+    pass: &JointPass,
+    a: &mut BodyState,
+    b: &mut BodyState,
+) -> Real {
+    let (bias, mass_scale, impulse_scale) = if margin > 0.0 {
+        (margin * pass.inv_h, 1.0, 0.0)
+    } else if pass.bias {
+        (
+            margin * pass.soft.bias_rate,
+            pass.soft.mass_scale,
+            pass.soft.impulse_scale,
+        )
+    } else {
+        (0.0, 1.0, 0.0)
+    };
+    let delta =
+        -row.mass(&fr.sa, &fr.sb) * mass_scale * (row.velocity(a, b) + bias) - impulse_scale * acc;
+    let total = (acc + delta).max(0.0);
+
+    row.apply(total - acc, &fr.sa, &fr.sb, a, b);
+    total
+}
+
+/// The impulse along the free coordinate's row: limits (the upper one's row is negated),
+/// motor, spring and rod.
+pub(super) fn free_impulse(imp: &JointImpulses) -> Real {
+    imp.lower - imp.upper + imp.motor + imp.spring + imp.axial
+}
+
+/// What acts on a joint's free coordinate, from its options: the limits (`limits`, a
+/// ball's `twist`, or a distance joint's `min`/`max` with an open end for the one left
+/// out), motor, spring (a distance spring pulls towards the rest length, whatever its
+/// `target`) and, for a distance joint with none of these, the rigid rod.
+#[derive(Clone, Copy, Default)]
+pub(super) struct FreeDrive {
+    limits: Option<[Real; 2]>,
+    motor: Option<Motor>,
+    spring: Option<JointSpring>,
+    rod: Option<Real>,
+}
+
+impl FreeDrive {
+    /// The drive of a free axis `free` with `options`; `rest` is the rest length.
+    pub fn of(free: Option<FreeAxis>, o: &JointOptions, rest: Real) -> FreeDrive {
+        let Some(free) = free else {
+            return FreeDrive::default();
+        };
+        let range = (o.min.is_some() || o.max.is_some()).then(|| {
+            [
+                o.min.unwrap_or(Real::NEG_INFINITY),
+                o.max.unwrap_or(Real::INFINITY),
+            ]
+        });
+        let distance = free == FreeAxis::Distance;
+        let spring = match o.spring {
+            Some(s) if distance => Some(JointSpring { target: rest, ..s }),
+            s => s,
+        };
+        let rigid = distance && o.spring.is_none() && range.is_none();
+        FreeDrive {
+            limits: o.limits.or(o.twist).or(range),
+            motor: o.motor,
+            spring,
+            rod: rigid.then_some(rest),
+        }
+    }
+
+    /// Whether nothing acts on the free coordinate.
+    pub fn is_idle(&self) -> bool {
+        self.limits.is_none() && self.motor.is_none() && self.spring.is_none() && self.rod.is_none()
+    }
+}
+
+/// Spring, motor, limits and (distance joints) the rigid rod along the free coordinate.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn solve_free(
+    drive: &FreeDrive,
+    row: Row,
+    coordinate: Real,
+    fr: &Frame,
+    pass: &JointPass,
+    imp: &mut JointImpulses,
+    a: &mut BodyState,
+    b: &mut BodyState,
+) {
+    if let Some(s) = drive.spring {
+        imp.spring = solve_spring(row, coordinate, &s, imp.spring, fr, pass, a, b);
+    }
+    if let Some(m) = drive.motor {
+        imp.motor = solve_motor(row, &m, imp.motor, fr, pass, a, b);
+    }
+    if let Some([lower, upper]) = drive.limits {
+        if lower.is_finite() {
+            imp.lower = solve_limit(row, coordinate - lower, imp.lower, fr, pass, a, b);
+        }
+        if upper.is_finite() {
+            imp.upper = solve_limit(row.negated(), upper - coordinate, imp.upper, fr, pass, a, b);
+        }
+    }
+    if let Some(rest) = drive.rod {
+        imp.axial = solve_rod(row, coordinate, rest, imp.axial, fr, pass, a, b);
+    }
+}
+
+/// The distance joint's rigid rod: the distance held at `rest` by the joint softness.
+#[allow(clippy::too_many_arguments)]
+fn solve_rod(
+    row: Row,
+    distance: Real,
+    rest: Real,
+    acc: Real,
+    fr: &Frame,
+    pass: &JointPass,
+    a: &mut BodyState,
+    b: &mut BodyState,
+) -> Real {
+    let bias = if pass.bias {
+        pass.soft.bias_rate * (distance - rest)
+    } else {
+        0.0
+    };
+    let delta = -row.mass(&fr.sa, &fr.sb) * pass.soft.mass_scale * (row.velocity(a, b) + bias)
+        - pass.soft.impulse_scale * acc;
+    row.apply(delta, &fr.sa, &fr.sb, a, b);
+    acc + delta
+}
+
+#[allow(clippy::too_many_arguments)]
+fn solve_spring(
+    row: Row,
+    coordinate: Real,
+    spring: &JointSpring,
+    acc: Real,
+    fr: &Frame,
+    pass: &JointPass,
+    a: &mut BodyState,
+    b: &mut BodyState,
+) -> Real {
+    let soft = Softness::new(spring.hertz, spring.damping_ratio, pass.h);
+    let bias = soft.bias_rate * (coordinate - spring.target);
+    let delta = -row.mass(&fr.sa, &fr.sb) * soft.mass_scale * (row.velocity(a, b) + bias)
+        - soft.impulse_scale * acc;
+    row.apply(delta, &fr.sa, &fr.sb, a, b);
+    acc + delta
+}
+
+fn solve_motor(
+    row: Row,
+    motor: &Motor,
+    acc: Real,
+    fr: &Frame,
+    pass: &JointPass,
+    a: &mut BodyState,
+    b: &mut BodyState,
+) -> Real {
+    let limit = motor.max_force * pass.h;
+    let delta = -row.mass(&fr.sa, &fr.sb) * (row.velocity(a, b) - motor.speed);
+    let total = (acc + delta).clamp(-limit, limit);
+    row.apply(total - acc, &fr.sa, &fr.sb, a, b);
+    total
+}

@@ -1,0 +1,604 @@
+//! The constraint solver: contacts and joints as impulses inside substeps.
+//!
+//! One step of `dt` with n substeps of h = dt/n, for the bodies that touch something:
+//!
+//! ```text
+//! prepare constraints (anchors, effective masses, last step's impulses)
+//! repeat n times:
+//!     kick      v += h F/m, L += h N            forces at the substep's state
+//!     warm start: apply the accumulated impulses
+//!     solve     (iterations passes, with position bias: soft spring or Baumgarte)
+//!     drift     x += h v, q by the rotor splitting with L (exact torque-free turning)
+//!     relax     (soft step only: passes without bias, removing the push-out velocity)
+//! bounces (restitution.rs), then store impulses for the next step's warm start
+//! ```
+//!
+//! This is Box2D v3's soft step (Catto 2024) carried to 3D, with angular momentum as the
+//! integrated rotational state so that constrained bodies tumble as correctly as free ones.
+
+mod body;
+mod contact;
+mod contact_wide;
+mod joint;
+mod lanes;
+mod mass_ratio;
+mod restitution;
+mod softness;
+
+pub use softness::Softness;
+
+pub(crate) use body::{BodySim, BodyState, SolverBodies};
+use contact::{BiasRule, ContactConstraint, PairData, Points};
+use joint::{JointConstraint, JointPass};
+
+use crate::collision::contact::Contact;
+use crate::dynamics::body::Motion;
+use crate::dynamics::body::{Body, BodyKind};
+use crate::dynamics::force::Wrench;
+use crate::dynamics::integrate::{exact_spin, rotor_drift, System};
+use crate::dynamics::joint::Joint;
+use crate::math::{Mat3, Real, Vec3};
+use std::ops::Range;
+
+/// Which velocity solver handles contacts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SolverKind {
+    /// Substepped soft constraints with relax and restitution passes (the default).
+    #[default]
+    SoftStep,
+    /// Classic projected Gauss–Seidel sequential impulses with Baumgarte correction.
+    Pgs,
+}
+
+impl SolverKind {
+    /// The name used in scene files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverKind::SoftStep => "soft_step",
+            SolverKind::Pgs => "pgs",
+        }
+    }
+    /// The kind called `name`.
+    pub fn from_name(name: &str) -> Option<SolverKind> {
+        [SolverKind::SoftStep, SolverKind::Pgs]
+            .into_iter()
+            .find(|k| k.name() == name)
+    }
+}
+
+/// Solver settings; `Default` is the soft step with 4 substeps and 1 iteration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverSettings {
+    /// Soft step or PGS.
+    pub kind: SolverKind,
+    /// Substeps per step.
+    pub substeps: u32,
+    /// Solve passes per substep (and relax passes, for the soft step).
+    pub iterations: u32,
+    /// Contact stiffness (Hz), capped at a quarter of the substep rate.
+    pub contact_hertz: Real,
+    /// Contact damping ratio (dimensionless).
+    pub contact_damping_ratio: Real,
+    /// Baumgarte factor for PGS (fraction of the error corrected per substep).
+    pub baumgarte: Real,
+    /// Stiffness of joints' drift correction (Hz), capped at a quarter of the substep rate.
+    pub joint_hertz: Real,
+    /// Damping ratio of joints' drift correction.
+    pub joint_damping_ratio: Real,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        SolverSettings {
+            kind: SolverKind::SoftStep,
+            substeps: 4,
+            iterations: 1,
+            contact_hertz: 60.0,
+            contact_damping_ratio: 10.0,
+            baumgarte: 0.2,
+            joint_hertz: 1000.0,
+            joint_damping_ratio: 0.5,
+        }
+    }
+}
+
+/// The times of one step, derived once: the step's start `t`, its length `dt`, and the
+/// solver's `substeps` of `h` = `dt` / `substeps` (`inv_h` = 1 / `h`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct StepTime {
+    pub t: Real,
+    pub dt: Real,
+    pub substeps: u32,
+    pub h: Real,
+    pub inv_h: Real,
+}
+
+impl StepTime {
+    pub fn new(t: Real, dt: Real, settings: &SolverSettings) -> StepTime {
+        let substeps = settings.substeps.max(1);
+        let h = dt / substeps as Real;
+        StepTime {
+            t,
+            dt,
+            substeps,
+            h,
+            inv_h: 1.0 / h,
+        }
+    }
+}
+
+/// Lengths and speeds the solver works with, all scaled from the world's length unit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Scales {
+    pub linear_slop: Real,
+    pub max_push: Real,
+    pub restitution_threshold: Real,
+}
+
+/// What the solver needs of a step.
+pub(crate) struct StepInput<'a, 'b> {
+    pub system: &'a mut System<'b>,
+    pub settings: &'a SolverSettings,
+    pub scales: &'a Scales,
+    /// Contacts to leave out this step (speculative ones the bodies will not reach).
+    pub ghosts: &'a [bool],
+    /// The world's joints, and the dense indices of each one's bodies (`None`: the world
+    /// or a broken joint's absent partner).
+    pub joints: &'a mut [Joint],
+    pub joint_bodies: &'a [[Option<usize>; 2]],
+    /// The step's time, length and substep.
+    pub time: &'a StepTime,
+}
+
+/// Buffers reused from step to step.
+#[derive(Default)]
+pub(crate) struct Solver {
+    /// The states at the step's start, for the bounce replay.
+    start_states: Vec<BodyState>,
+    moving: Vec<bool>,
+    constraints: Vec<ContactConstraint>,
+    points: Points,
+    joints: Vec<JointConstraint>,
+    /// Per body, whether its island has a large mass ratio (see `mass_ratio`); empty when
+    /// none has. Such islands' contacts and joints sit at the end of their lists, from
+    /// `heavy_contacts` and `heavy_joints`, and get `heavy_passes` times the passes.
+    heavy: Vec<bool>,
+    heavy_contacts: usize,
+    heavy_joints: usize,
+    heavy_passes: u32,
+    /// Bodies whose kick is split around the drift (see `split_kicks`).
+    split_kick: Vec<bool>,
+    wrench: Vec<Wrench>,
+    motions: Vec<Motion>,
+}
+
+impl Solver {
+    /// Stage of the step: advances the bodies the solver moves (`moves` in `bodies`, at
+    /// their start-of-step states) through the substeps, in place. Reads the contacts,
+    /// joints, forces and settings of `input`; writes the moved bodies' states, every
+    /// solved contact's impulses and every solved joint's reaction.
+    pub fn step(
+        &mut self,
+        mut input: StepInput<'_, '_>,
+        bodies: &mut SolverBodies,
+        contacts: &mut [Contact],
+    ) {
+        let world_bodies = input.system.bodies;
+        let time = input.time;
+        self.start_states.clone_from(&bodies.states);
+        let rule = bias_rule(input.settings, input.scales, time);
+        self.find_heavy_islands(
+            bodies,
+            contacts,
+            input.ghosts,
+            input.joints,
+            input.joint_bodies,
+        );
+        self.prepare(bodies, contacts, input.ghosts);
+        self.prepare_joints(bodies, world_bodies, input.joints, input.joint_bodies);
+        let passes = joint_passes(input.settings, time);
+        let any_split = self.split_kicks(bodies);
+        for i in 0..time.substeps {
+            self.substep(bodies, &mut input, (&rule, &passes), i, any_split);
+        }
+        for j in &self.joints {
+            j.store(&mut input.joints[j.joint], time.dt);
+        }
+        self.moving.clear();
+        self.moving.extend(bodies.sims.iter().map(|s| s.moves));
+        restitution::resolve_bounces(
+            &self.constraints,
+            &mut self.points,
+            &mut bodies.states,
+            &self.start_states,
+            &self.moving,
+            input.scales.restitution_threshold,
+        );
+        for c in &self.constraints {
+            c.store_impulses(&self.points, &mut contacts[c.contact]);
+        }
+        for ((sim, state), body) in bodies
+            .sims
+            .iter_mut()
+            .zip(&mut bodies.states)
+            .zip(world_bodies)
+        {
+            if sim.moves {
+                sim.sync_momentum(state);
+                state.w = body.omega_from_momentum(sim.q, sim.l);
+            }
+        }
+    }
+
+    /// Substep `i`: kick, warm start, solve, drift, relax (see the module header).
+    fn substep(
+        &mut self,
+        bodies: &mut SolverBodies,
+        input: &mut StepInput<'_, '_>,
+        (rule, (solve_pass, relax_pass)): (&BiasRule, &(JointPass, JointPass)),
+        i: u32,
+        any_split: bool,
+    ) {
+        let (h, world_bodies) = (input.time.h, input.system.bodies);
+        let t = input.time.t + i as Real * h;
+        // After a split kick's second half the forces are those of this substep's start.
+        self.kick(bodies, input.system, t, h, (i == 0 || !any_split, false));
+        for j in &mut self.joints {
+            j.warm_start(&bodies.sims, &mut bodies.states);
+        }
+        contact_wide::warm_start(&self.constraints, &self.points, &mut bodies.states);
+        let iterations = input.settings.iterations;
+        let relax = input.settings.kind == SolverKind::SoftStep && iterations > 0;
+        self.passes(bodies, iterations, (rule, solve_pass), true, !relax);
+        self.drift(bodies, world_bodies, h);
+        if any_split {
+            self.kick(bodies, input.system, t + h, h, (true, true));
+        }
+        if relax {
+            self.passes(bodies, iterations, (rule, relax_pass), false, true);
+        }
+        if iterations == 0 {
+            ContactConstraint::add_to_totals(&self.points.hot, &mut self.points.cold);
+        }
+        for j in &mut self.joints {
+            j.add_to_totals(&bodies.sims);
+        }
+    }
+
+    /// `iterations` passes over the joints then the contacts, with `bias` or without
+    /// (relax); islands with a large mass ratio get two or three times as many. The substep's impulses
+    /// are final once the last pass has visited a manifold, so with `totals` that pass adds
+    /// them to the step's totals on its way instead of a separate walk over every point.
+    fn passes(
+        &mut self,
+        bodies: &mut SolverBodies,
+        iterations: u32,
+        rules: (&BiasRule, &JointPass),
+        bias: bool,
+        totals: bool,
+    ) {
+        let (rule, joint_pass) = rules;
+        let parts = [
+            (0..self.heavy_contacts, 0..self.heavy_joints, iterations),
+            (
+                self.heavy_contacts..self.constraints.len(),
+                self.heavy_joints..self.joints.len(),
+                self.heavy_passes * iterations,
+            ),
+        ];
+        for (contacts, joints, count) in parts {
+            for k in 0..count {
+                for j in &mut self.joints[joints.clone()] {
+                    j.solve(&bodies.sims, &mut bodies.states, joint_pass);
+                }
+                let last = totals && k + 1 == count;
+                self.solve_pass(bodies, contacts.clone(), rule, bias, last);
+            }
+        }
+    }
+
+    /// Marks the bodies of islands with a large mass ratio (see `mass_ratio`), over the
+    /// contacts and joints the step will solve.
+    fn find_heavy_islands(
+        &mut self,
+        bodies: &SolverBodies,
+        contacts: &[Contact],
+        ghosts: &[bool],
+        joints: &[Joint],
+        joint_bodies: &[[Option<usize>; 2]],
+    ) {
+        let touching = contacts
+            .iter()
+            .enumerate()
+            .filter(|&(i, c)| !idle(c, i, ghosts))
+            .map(|(_, c)| (c.index_a as usize, c.index_b as usize));
+        let joined =
+            joints
+                .iter()
+                .zip(joint_bodies)
+                .filter_map(|(j, link)| match (j.broken, *link) {
+                    (false, [Some(a), Some(b)]) => Some((a, b)),
+                    _ => None,
+                });
+        (self.heavy, self.heavy_passes) =
+            mass_ratio::heavy_islands(&bodies.sims, touching.chain(joined)).unwrap_or_default();
+    }
+
+    fn prepare(&mut self, bodies: &SolverBodies, contacts: &[Contact], ghosts: &[bool]) {
+        self.constraints.clear();
+        self.points.clear();
+        let order = self.colour_order(&bodies.sims, contacts, ghosts);
+        self.heavy_contacts = order.partition_point(|&(heavy, _, _)| !heavy);
+        for (_, colour, i) in order {
+            let c = &contacts[i];
+            let (a, b) = (c.index_a as usize, c.index_b as usize);
+            let (sa, sb) = (&bodies.sims[a], &bodies.sims[b]);
+            let friction = (sa.friction * sb.friction).sqrt();
+            let restitution = sa.restitution.max(sb.restitution);
+            let pose = |k: usize| {
+                let s = &bodies.sims[k];
+                crate::collision::geometry::Pose::new(s.x - s.q * s.local_center, s.q)
+            };
+            let pair = PairData {
+                bodies: (a, b),
+                material: (friction, restitution),
+                poses: (pose(a), pose(b)),
+            };
+            self.constraints.push(ContactConstraint::prepare(
+                (i, colour),
+                c,
+                &pair,
+                (&bodies.sims, &bodies.states),
+                &mut self.points,
+            ));
+        }
+        self.points
+            .group_lanes(&self.constraints, self.heavy_contacts);
+    }
+
+    /// Chooses each body's kick. Bodies in contact take symplectic Euler's whole kick
+    /// before the solve: a resting contact must see the substep's full approach, and the
+    /// contact tuning (stacks, friction anchors, sleeping) rests on it. Bodies held only by
+    /// joints take half a kick before the solve and half after the drift, so joint-held
+    /// motion is Störmer–Verlet with the solve and the relax pass enforcing the position and
+    /// velocity constraints (RATTLE): second order, where symplectic Euler's O(h) energy
+    /// wobble moved a 2 rad pendulum's energy by 1.1 %. Returns whether any body splits.
+    fn split_kicks(&mut self, bodies: &SolverBodies) -> bool {
+        self.split_kick.clear();
+        self.split_kick.extend(bodies.sims.iter().map(|s| s.moves));
+        for c in &self.constraints {
+            let (a, b) = c.bodies();
+            self.split_kick[a] = false;
+            self.split_kick[b] = false;
+        }
+        self.split_kick.iter().any(|s| *s)
+    }
+
+    /// The joints that join at least one body the solver moves, in creation order.
+    fn prepare_joints(
+        &mut self,
+        solver_bodies: &SolverBodies,
+        bodies: &[Body],
+        joints: &[Joint],
+        links: &[[Option<usize>; 2]],
+    ) {
+        self.joints.clear();
+
+        for (i, (joint, link)) in joints.iter().zip(links).enumerate() {
+            if joint.broken {
+                continue;
+            }
+            let center = |k: Option<usize>| k.map_or(Vec3::ZERO, |k| bodies[k].local_center);
+            let c = JointConstraint::new(
+                i,
+                joint,
+                [(link[0], center(link[0])), (link[1], center(link[1]))],
+            );
+            if c.active(&solver_bodies.sims) {
+                self.joints.push(c);
+            }
+        }
+        // Joints of islands with a large mass ratio go last, in creation order, for their
+        // extra passes (see `passes`); the others keep their order.
+        let flags = &self.heavy;
+        let heavy =
+            |c: &JointConstraint| c.bodies().into_iter().flatten().any(|k| is_heavy(flags, k));
+        let (mut light, heavy): (Vec<_>, Vec<_>) = self.joints.drain(..).partition(|c| !heavy(c));
+        self.heavy_joints = light.len();
+        light.extend(heavy);
+        self.joints = light;
+    }
+
+    /// The contacts to solve, ordered so that neighbours in the list rarely share a moving
+    /// body (greedy graph colouring, colour by colour). Gauss–Seidel passes are a chain of
+    /// dependent updates; constraints on disjoint bodies let the processor overlap them.
+    /// Deterministic: colours depend only on the contacts' order, itself deterministic.
+    /// Contacts of islands with a large mass ratio come last, for their extra passes.
+    /// Colour 63 keeps the contacts' order.
+    fn colour_order(
+        &self,
+        sims: &[BodySim],
+        contacts: &[Contact],
+        ghosts: &[bool],
+    ) -> Vec<(bool, u32, usize)> {
+        let mut used = vec![0u64; sims.len()];
+        let mut coloured = Vec::with_capacity(contacts.len());
+        for (i, c) in contacts.iter().enumerate() {
+            let (a, b) = (c.index_a as usize, c.index_b as usize);
+            if idle(c, i, ghosts) || !(sims[a].moves || sims[b].moves) {
+                continue;
+            }
+            let mask = |k: usize| if sims[k].moves { used[k] } else { 0 };
+            let colour = (!(mask(a) | mask(b))).trailing_zeros().min(63);
+            for k in [a, b] {
+                if sims[k].moves {
+                    used[k] |= 1u64 << colour;
+                }
+            }
+            let heavy = is_heavy(&self.heavy, a) || is_heavy(&self.heavy, b);
+            coloured.push((heavy, colour, i));
+        }
+        // Within a colour below 63 the order is free (no moving body in common, so the
+        // updates commute, bit for bit): manifolds of equal size go together, so that the
+        // lane groups (see `contact_wide`) carry few empty points.
+        let size = |colour: u32, i: usize| match colour {
+            63 => 0,
+            _ => contacts[i].manifold.len(),
+        };
+        coloured.sort_unstable_by_key(|&(heavy, colour, i)| (heavy, colour, size(colour, i), i));
+        coloured
+    }
+
+    /// One pass over the constraints in `range`, in colour order; consecutive constraints
+    /// of one colour are solved several at a time in lanes (see `contact_wide`).
+    fn solve_pass(
+        &mut self,
+        bodies: &mut SolverBodies,
+        range: Range<usize>,
+        rule: &BiasRule,
+        bias: bool,
+        totals: bool,
+    ) {
+        let pass = contact_wide::Pass { rule, bias, totals };
+        let (cs, points, states) = (&self.constraints, &mut self.points, &mut bodies.states);
+        contact_wide::solve_pass(cs, range, points, states, pass);
+    }
+
+    /// v += h F/m, L += h N, over the substep's start (`end` false) or end: bodies in
+    /// contact take the whole kick first (symplectic Euler), the others half at each end.
+    fn kick(
+        &mut self,
+        bodies: &mut SolverBodies,
+        system: &mut System<'_>,
+        t: Real,
+        h: Real,
+        (evaluate, end): (bool, bool),
+    ) {
+        if evaluate {
+            self.evaluate_forces(bodies, system, t);
+        }
+        for ((((sim, state), w), body), &split) in bodies
+            .sims
+            .iter_mut()
+            .zip(&mut bodies.states)
+            .zip(&self.wrench)
+            .zip(system.bodies)
+            .zip(&self.split_kick)
+        {
+            let h = match (split, end) {
+                (true, _) => 0.5 * h,
+                (false, false) => h,
+                (false, true) => continue,
+            };
+            if sim.moves {
+                sim.sync_momentum(state);
+                state.v += sim.linear_mask * w.force * (sim.inv_mass * h);
+                sim.l += w.torque * h;
+                state.w = body.omega_from_momentum(sim.q, sim.l);
+                sim.w_synced = state.w;
+            }
+        }
+    }
+
+    /// Every force element and callback at the solver's current state and time `t`.
+    fn evaluate_forces(&mut self, bodies: &SolverBodies, system: &mut System<'_>, t: Real) {
+        self.motions.clear();
+        self.motions
+            .extend((0..bodies.sims.len()).map(|i| bodies.motion(i)));
+        self.wrench.resize(self.motions.len(), Wrench::default());
+        system.wrenches(t, &self.motions, &mut self.wrench);
+    }
+
+    /// x += h v and the exact torque-free rotation with L; kinematic bodies move too, so
+    /// contacts see them where they are.
+    fn drift(&mut self, solver_bodies: &mut SolverBodies, bodies: &[Body], h: Real) {
+        let (sims, states) = (&mut solver_bodies.sims, &mut solver_bodies.states);
+        for ((sim, state), body) in sims.iter_mut().zip(states.iter_mut()).zip(bodies) {
+            match (sim.moves, body.kind) {
+                (true, _) => {
+                    sim.sync_momentum(state);
+                    sim.x += state.v * h;
+                    sim.q = rotor_drift(body, sim.q, sim.l, state.w, h);
+                    state.w = body.omega_from_momentum(sim.q, sim.l);
+                    sim.w_synced = state.w;
+                }
+                (false, BodyKind::Kinematic) => {
+                    sim.x += state.v * h;
+                    sim.q = exact_spin(state.w, sim.q, h);
+                }
+                _ => continue,
+            }
+            state.dp = sim.x - sim.x0;
+            state.dr = Mat3::from_quat(sim.q * sim.q0.inverse());
+        }
+    }
+}
+
+/// Whether body `k` is in an island with a large mass ratio, by the solver's `heavy` flags
+/// (empty when no island has one).
+fn is_heavy(heavy: &[bool], k: usize) -> bool {
+    heavy.get(k).copied().unwrap_or(false)
+}
+
+/// Whether contact `i` sits the step out: no points, or a speculative ghost.
+fn idle(c: &Contact, i: usize, ghosts: &[bool]) -> bool {
+    c.manifold.is_empty() || ghosts.get(i).copied().unwrap_or(false)
+}
+
+/// How joints treat drift in the solve and the relax passes: the joint spring (capped at
+/// a quarter of the substep rate) then none, for the soft step; Baumgarte then nothing
+/// (there is no relax pass) for PGS.
+fn joint_passes(settings: &SolverSettings, time: &StepTime) -> (JointPass, JointPass) {
+    let soft = biased_softness(
+        settings,
+        settings.joint_hertz,
+        settings.joint_damping_ratio,
+        time,
+    );
+    let pass = |soft, bias| JointPass {
+        soft,
+        bias,
+        inv_h: time.inv_h,
+        h: time.h,
+    };
+    (pass(soft, true), pass(Softness::RIGID, false))
+}
+
+/// Position correction in a biased pass: for the soft step a spring of `hertz` (capped at
+/// a quarter of the substep rate, as in Box2D) and damping ratio `zeta`; for PGS the rigid
+/// row with Baumgarte's β/h.
+fn biased_softness(
+    settings: &SolverSettings,
+    hertz: Real,
+    zeta: Real,
+    time: &StepTime,
+) -> Softness {
+    match settings.kind {
+        SolverKind::SoftStep => Softness::new(hertz.min(0.25 * time.inv_h), zeta, time.h),
+        SolverKind::Pgs => Softness {
+            bias_rate: settings.baumgarte * time.inv_h,
+            mass_scale: 1.0,
+            impulse_scale: 0.0,
+        },
+    }
+}
+
+/// Contacts' position correction and the lengths and speeds they work with.
+fn bias_rule(settings: &SolverSettings, scales: &Scales, time: &StepTime) -> BiasRule {
+    BiasRule {
+        inv_h: time.inv_h,
+        softness: biased_softness(
+            settings,
+            settings.contact_hertz,
+            settings.contact_damping_ratio,
+            time,
+        ),
+        slop: if settings.kind == SolverKind::Pgs {
+            scales.linear_slop
+        } else {
+            0.0
+        },
+        max_push: scales.max_push,
+        slip_speed: scales.linear_slop,
+    }
+}

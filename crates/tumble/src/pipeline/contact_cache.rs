@@ -1,0 +1,496 @@
+//! Persistent contacts: the narrow phase run over the broad phase's pairs, with every new
+//! manifold point matched by feature id to last step's, so the solver can start from the
+//! impulses it found then (warm starting).
+
+use crate::collision::broad_phase::BroadPhase;
+use crate::collision::contact::{Basis, Key, REUSE_DISTANCE};
+pub use crate::collision::contact::{Contact, ContactEvent, ContactEventKind};
+use crate::collision::geometry::{Aabb, Pose};
+use crate::collision::narrow_phase::{collide, Manifold};
+use crate::dynamics::body::{Body, BodyKind};
+use crate::id::BodyId;
+use crate::math::{Real, Vec3};
+
+/// Shapes whose pair yields at most one manifold with fixed sub-shapes (0, 0), so that a
+/// reused manifold stands for the whole pair.
+fn reusable(shape: &crate::collision::shape::Shape) -> bool {
+    use crate::collision::shape::Shape as S;
+    matches!(
+        shape,
+        S::Sphere { .. }
+            | S::Box { .. }
+            | S::Capsule { .. }
+            | S::Cylinder { .. }
+            | S::ConvexHull(_)
+    )
+}
+
+/// The current contacts and the previous step's, for matching.
+#[derive(Debug, Default)]
+pub(crate) struct ContactCache {
+    contacts: Vec<Contact>,
+    previous: Vec<Contact>,
+    /// Indices of `previous` sorted by contact key: sorting indices moves 4 bytes each
+    /// where sorting the contacts would move hundreds.
+    order: Vec<u32>,
+    /// The contact keys of `previous` in that order: searches read these 24 bytes, not
+    /// a cache line of each kilobyte-sized contact.
+    keys: Vec<Key>,
+    /// Scratch for sorting `keys` with their indices.
+    keyed: Vec<(Key, u32)>,
+    events: Vec<ContactEvent>,
+    pairs: Vec<(u32, u32)>,
+    manifolds: Vec<Manifold>,
+    /// The touching body pairs of `contacts` and of `previous`, sorted: last update's
+    /// list is this one's `before`, so each update sorts only its own.
+    touching: Vec<(BodyId, BodyId)>,
+    touching_before: Vec<(BodyId, BodyId)>,
+    /// The bodies' tight boxes, computed as pairs need them.
+    tight: TightBoxes,
+    /// Scratch for broad-phase queries.
+    stack: Vec<u32>,
+}
+
+/// Each body's tight box at its current pose, computed once per update on first use.
+#[derive(Debug, Default)]
+struct TightBoxes {
+    boxes: Vec<Option<Aabb>>,
+}
+
+impl TightBoxes {
+    fn clear(&mut self, bodies: usize) {
+        self.boxes.clear();
+        self.boxes.resize(bodies, None);
+    }
+
+    fn get_or_insert(&mut self, i: usize, body: &Body) -> &Aabb {
+        self.boxes[i].get_or_insert_with(|| body.shape.aabb(&body.pose()))
+    }
+}
+
+/// Whether the boxes are more than `gap` apart along some axis. NaN compares false: such a
+/// pair is left to the narrow phase.
+fn apart(a: &Aabb, b: &Aabb, gap: Real) -> bool {
+    a.min.x - b.max.x > gap
+        || b.min.x - a.max.x > gap
+        || a.min.y - b.max.y > gap
+        || b.min.y - a.max.y > gap
+        || a.min.z - b.max.z > gap
+        || b.min.z - a.max.z > gap
+}
+
+/// Whether the pair at body indices `(a, b)` needs contacts at all: one of the two must be
+/// dynamic, and bodies a joint holds together do not collide unless it says so.
+fn may_collide(
+    body_a: &Body,
+    body_b: &Body,
+    (a, b): (usize, usize),
+    joined: &[(u32, u32)],
+) -> bool {
+    if body_a.kind != BodyKind::Dynamic && body_b.kind != BodyKind::Dynamic {
+        return false;
+    }
+    let key = (a.min(b) as u32, a.max(b) as u32);
+    joined.is_empty() || joined.binary_search(&key).is_err()
+}
+
+/// A body that cannot have moved since the last step: static, or dynamic and asleep.
+fn frozen(b: &Body) -> bool {
+    b.kind == BodyKind::Static || (b.kind == BodyKind::Dynamic && !b.awake)
+}
+
+/// Reuses last step's contact of the pair if their relative pose still holds it, placing it
+/// at the new poses; whether it did.
+fn reuse_previous(
+    old: &Sorted<'_>,
+    (a, b): (usize, usize),
+    ids: &[BodyId],
+    (pa, pb): (&Pose, &Pose),
+    margin: Real,
+    contacts: &mut Vec<Contact>,
+) -> bool {
+    let Some(c) = old.find((ids[a], ids[b], 0, 0)).filter(|c| {
+        c.basis
+            .holds(&Basis::relative(pa, pb), REUSE_DISTANCE * margin)
+    }) else {
+        return false;
+    };
+    // Updated in place: a contact is a kilobyte, and a copy on the stack
+    // before the push doubled what this costs.
+    contacts.push(*c);
+    let contact = contacts.last_mut().expect("just pushed");
+    (contact.index_a, contact.index_b) = (a as u32, b as u32);
+    contact.basis.place(&mut contact.manifold, pa, pb);
+    // Matches each point to itself, but re-anchors the ones that slid.
+    warm_start(contact, old, (pa, pb));
+    true
+}
+
+/// Pushes a contact for each of the pair's freshly computed manifolds, warm-started from
+/// last step's.
+fn push_new(
+    manifolds: &[Manifold],
+    old: &Sorted<'_>,
+    (a, b): (usize, usize),
+    ids: &[BodyId],
+    (pa, pb): (&Pose, &Pose),
+    contacts: &mut Vec<Contact>,
+) {
+    for manifold in manifolds {
+        contacts.push(Contact {
+            body_a: ids[a],
+            body_b: ids[b],
+            manifold: *manifold,
+            index_a: a as u32,
+            index_b: b as u32,
+            basis: Basis::of(manifold, pa, pb),
+        });
+        let contact = contacts.last_mut().expect("just pushed");
+        warm_start(contact, old, (pa, pb));
+    }
+}
+
+impl ContactCache {
+    /// The contacts found by the last update, ordered by body pair.
+    pub fn contacts(&self) -> &[Contact] {
+        &self.contacts
+    }
+
+    /// Recomputes every contact from the broad phase's pairs. Pairs in which neither body
+    /// is dynamic are skipped: nothing could respond to them.
+    pub fn update(
+        &mut self,
+        broad: &mut BroadPhase,
+        bodies: &[Body],
+        ids: &[BodyId],
+        margin: Real,
+        joined: &[(u32, u32)],
+    ) {
+        broad.pairs(&mut self.pairs);
+        let statics = bodies.iter().filter(|b| b.kind == BodyKind::Static).count();
+        std::mem::swap(&mut self.contacts, &mut self.previous);
+        self.index_previous();
+        let old = Sorted {
+            list: &self.previous,
+            order: &self.order,
+            keys: &self.keys,
+            hint: std::cell::Cell::new(0),
+        };
+        self.contacts.clear();
+        self.tight.clear(bodies.len());
+        for &(a, b) in &self.pairs {
+            let (a, b) = (a as usize, b as usize);
+            let (Some(body_a), Some(body_b)) = (bodies.get(a), bodies.get(b)) else {
+                continue;
+            };
+            if !may_collide(body_a, body_b, (a, b), joined) {
+                continue;
+            }
+            // A sleeping island costs nothing: between bodies that cannot have moved, last
+            // step's manifolds still hold.
+            if frozen(body_a) && frozen(body_b) {
+                keep_previous(&old, ids[a], ids[b], a, b, &mut self.contacts);
+                continue;
+            }
+            // The broad phase pairs fat boxes, stretched along each body's motion: as the
+            // rain lands, six pairs in seven are farther apart than the margin. Every
+            // routine reports only points closer than `margin`, and a gap between the
+            // tight boxes is a lower bound of the distance, so a pair whose tight boxes
+            // stand more than twice the margin apart (room to spare over rounding) has no
+            // manifold, and is passed over without asking the narrow phase. Nor can it have
+            // a manifold to reuse: that needs a gap under the margin a few µm ago.
+            let mut tight = |i: usize| *self.tight.get_or_insert(i, &bodies[i]);
+            if apart(&tight(a), &tight(b), 2.0 * margin) {
+                continue;
+            }
+            let (pa, pb) = (body_a.pose(), body_b.pose());
+            let poses = (&pa, &pb);
+            if reusable(&body_a.shape)
+                && reusable(&body_b.shape)
+                && reuse_previous(&old, (a, b), ids, poses, margin, &mut self.contacts)
+            {
+                continue;
+            }
+            self.manifolds.clear();
+            collide(
+                &body_a.shape,
+                &body_a.pose(),
+                &body_b.shape,
+                &body_b.pose(),
+                margin,
+                &mut self.manifolds,
+            );
+            if statics > 1 {
+                for m in &mut self.manifolds {
+                    let stack = &mut self.stack;
+                    drop_covered_points(m, (a, b), bodies, (broad, stack), margin * 0.25);
+                }
+                self.manifolds.retain(|m| !m.is_empty());
+            }
+            push_new(
+                &self.manifolds,
+                &old,
+                (a, b),
+                ids,
+                poses,
+                &mut self.contacts,
+            );
+        }
+        self.find_events();
+    }
+
+    /// Sorts `previous` by key into `order` and `keys`. Keys are read once, in list order,
+    /// and sorted with their indices: a sort that fetched each key from its kilobyte-sized
+    /// contact missed the cache per comparison.
+    fn index_previous(&mut self) {
+        self.keyed.clear();
+        self.keyed
+            .extend(self.previous.iter().zip(0..).map(|(c, i)| (c.key(), i)));
+        // Stable, as the sort of indices it replaces was.
+        self.keyed.sort_by_key(|&(key, _)| key);
+        self.order.clear();
+        self.order.extend(self.keyed.iter().map(|&(_, i)| i));
+        self.keys.clear();
+        self.keys.extend(self.keyed.iter().map(|&(key, _)| key));
+    }
+
+    /// Begin and end events since the previous update, by body pair.
+    pub fn events(&self) -> &[ContactEvent] {
+        &self.events
+    }
+
+    fn find_events(&mut self) {
+        std::mem::swap(&mut self.touching, &mut self.touching_before);
+        self.touching.clear();
+        self.touching.extend(
+            self.contacts
+                .iter()
+                .filter(|c| !c.manifold.is_empty())
+                .map(|c| (c.body_a, c.body_b)),
+        );
+        self.touching.sort();
+        self.touching.dedup();
+        let (now, before) = (&self.touching, &self.touching_before);
+        self.events.clear();
+        // Both lists are sorted: one merge-like walk per direction finds what is missing
+        // from the other, where a binary search per pair was a third of the update's time.
+        self.events
+            .extend(missing(now, before, ContactEventKind::Begin));
+        self.events
+            .extend(missing(before, now, ContactEventKind::End));
+    }
+
+    /// The contacts, for the solver to store impulses in.
+    pub fn contacts_mut(&mut self) -> &mut [Contact] {
+        &mut self.contacts
+    }
+
+    /// Forgets every contact of a removed body that stood at dense index `index`, and
+    /// renumbers the bodies after it.
+    pub fn forget(&mut self, id: BodyId, index: usize) {
+        for c in self
+            .contacts
+            .iter()
+            .filter(|c| (c.body_a == id || c.body_b == id) && !c.manifold.is_empty())
+        {
+            let event = ContactEvent {
+                kind: ContactEventKind::End,
+                body_a: c.body_a,
+                body_b: c.body_b,
+            };
+            if !self.events.contains(&event) {
+                self.events.push(event);
+            }
+        }
+        self.contacts.retain(|c| c.body_a != id && c.body_b != id);
+        self.touching.retain(|&(a, b)| a != id && b != id);
+        let shift = |i: &mut u32| {
+            if *i as usize > index {
+                *i -= 1;
+            }
+        };
+        for c in &mut self.contacts {
+            shift(&mut c.index_a);
+            shift(&mut c.index_b);
+        }
+        self.previous.clear();
+    }
+}
+
+/// Removes the points of a contact with a static body that press on a face another static
+/// body covers. A floor of adjoining boxes has inner side faces that nothing can reach
+/// without first passing through the neighbour; a body sliding over a seam would otherwise
+/// meet the next box's side face (its separating axis wins while the gap is open) and catch.
+/// The test: step `nudge` from the point on the static surface along its outward normal;
+/// landing inside (or within a tenth of `nudge` of) another static body means the face is
+/// covered there.
+fn drop_covered_points(
+    m: &mut Manifold,
+    (a, b): (usize, usize),
+    bodies: &[Body],
+    (broad, stack): (&BroadPhase, &mut Vec<u32>),
+    nudge: Real,
+) {
+    let (sa, sb) = (
+        bodies[a].kind == BodyKind::Static,
+        bodies[b].kind == BodyKind::Static,
+    );
+    if sa == sb {
+        return;
+    }
+    // Outward from the static body: +n if it is A (the normal points from A to B).
+    let (fixed, out) = if sa { (a, m.normal) } else { (b, -m.normal) };
+    let mut covered = |surface: Vec3| {
+        let probe = surface + out * nudge;
+        let mut inside = false;
+        // Static bodies have static proxies only.
+        broad.query_static_aabb_with(&Aabb::new(probe, probe), stack, |user| {
+            let k = user as usize;
+            if !inside && k != fixed {
+                if let Some(other) = bodies.get(k).filter(|o| o.kind == BodyKind::Static) {
+                    // Within a tenth of the step of the other body counts: the normal can be
+                    // tilted by a hair and lift the probe off a face level with this one.
+                    inside =
+                        crate::collision::query::project_point(&other.shape, &other.pose(), probe)
+                            .is_some_and(|p| p.distance <= 0.1 * nudge);
+                }
+            }
+        });
+        inside
+    };
+    m.retain(|p| !covered(if sa { p.point_a } else { p.point_b }));
+}
+
+/// Last step's contacts, searchable by key.
+struct Sorted<'a> {
+    list: &'a [Contact],
+    order: &'a [u32],
+    keys: &'a [Key],
+    /// Where the last `find` ended (see [`Sorted::first_not_below`]).
+    hint: std::cell::Cell<usize>,
+}
+
+impl Sorted<'_> {
+    fn at(&self, k: usize) -> &Contact {
+        &self.list[self.order[k] as usize]
+    }
+
+    /// The contact with exactly this key.
+    fn find(&self, key: Key) -> Option<&Contact> {
+        let k = self.first_not_below(key);
+        self.hint.set(k);
+        (self.keys.get(k) == Some(&key)).then(|| self.at(k))
+    }
+
+    /// The first position whose key is not below `key` (a partition point). Lookups come
+    /// in key order (the broad phase lists pairs sorted, and contacts were made in that
+    /// order), so it is usually a few steps on from the last one's; a binary search
+    /// otherwise.
+    fn first_not_below(&self, key: Key) -> usize {
+        let keys = self.keys;
+        let mut k = self.hint.get().min(keys.len());
+        if k == 0 || keys[k - 1] < key {
+            for _ in 0..8 {
+                if k == keys.len() || keys[k] >= key {
+                    return k;
+                }
+                k += 1;
+            }
+        }
+        keys.partition_point(|&x| x < key)
+    }
+
+    /// Every contact between the two bodies, in key order.
+    fn pair(&self, a: BodyId, b: BodyId) -> impl Iterator<Item = &Contact> {
+        let k = self.keys.partition_point(|x| (x.0, x.1) < (a, b));
+        (k..self.order.len())
+            .map(|k| self.at(k))
+            .take_while(move |c| (c.body_a, c.body_b) == (a, b))
+    }
+}
+
+/// The pairs of sorted `list` absent from sorted `other`, as events of `kind`.
+fn missing<'a>(
+    list: &'a [(BodyId, BodyId)],
+    other: &'a [(BodyId, BodyId)],
+    kind: ContactEventKind,
+) -> impl Iterator<Item = ContactEvent> + 'a {
+    let mut k = 0;
+    list.iter().filter_map(move |&pair| {
+        while other.get(k).is_some_and(|&p| p < pair) {
+            k += 1;
+        }
+        (other.get(k) != Some(&pair)).then_some(ContactEvent {
+            kind,
+            body_a: pair.0,
+            body_b: pair.1,
+        })
+    })
+}
+
+/// Carries the previous contacts of the pair (a, b) over unchanged.
+fn keep_previous(
+    previous: &Sorted<'_>,
+    id_a: BodyId,
+    id_b: BodyId,
+    a: usize,
+    b: usize,
+    out: &mut Vec<Contact>,
+) {
+    for c in previous.pair(id_a, id_b) {
+        out.push(Contact {
+            index_a: a as u32,
+            index_b: b as u32,
+            ..*c
+        });
+    }
+}
+
+/// Copies last step's impulses onto this step's points: by feature id, or, for a point
+/// whose features were renamed (a pair routine may pick the other box's face as reference
+/// from one step to the next), by proximity — the old point within `MATCH_DISTANCE` of it.
+/// Losing warm starts on a resting stack would restart its solution from zero each time.
+fn warm_start(contact: &mut Contact, previous: &Sorted<'_>, poses: (&Pose, &Pose)) {
+    let anchor_here = |p: &mut crate::collision::narrow_phase::ContactPoint| {
+        let mid = (p.point_a + p.point_b) * 0.5;
+        p.anchor_a = poses.0.inverse_transform_point(mid);
+        p.anchor_b = poses.1.inverse_transform_point(mid);
+        p.anchored = true;
+    };
+    let Some(old) = previous.find(contact.key()).map(|c| &c.manifold) else {
+        contact
+            .manifold
+            .points_mut()
+            .iter_mut()
+            .for_each(anchor_here);
+        return;
+    };
+    let mid = |a: Vec3, b: Vec3| (a + b) * 0.5;
+    for p in contact.manifold.points_mut() {
+        let here = mid(p.point_a, p.point_b);
+        let by_feature = old.points().iter().find(|q| q.feature == p.feature);
+        let by_place = || {
+            old.points()
+                .iter()
+                .map(|q| (q, (mid(q.point_a, q.point_b) - here).length_squared()))
+                .filter(|(_, d2)| *d2 < MATCH_DISTANCE * MATCH_DISTANCE)
+                .min_by(|x, y| x.1.total_cmp(&y.1))
+                .map(|(q, _)| q)
+        };
+        match by_feature.or_else(by_place) {
+            Some(q) => {
+                p.normal_impulse = q.normal_impulse;
+                p.tangent_impulse = q.tangent_impulse;
+                if q.anchored && !q.sliding {
+                    (p.anchor_a, p.anchor_b, p.anchored) = (q.anchor_a, q.anchor_b, true);
+                } else {
+                    anchor_here(p);
+                }
+            }
+            None => anchor_here(p),
+        }
+    }
+}
+
+/// How close an unnamed point must be to last step's to inherit its impulses (m).
+const MATCH_DISTANCE: Real = 0.01;

@@ -1,0 +1,21 @@
+//! The pipeline: the world that owns bodies, shapes, forces and joints, and the step that
+//! runs collision and dynamics over them in stages (`world/step.rs`).
+//!
+//! ```text
+//! world/         World, WorldDef and the stores of its lasting state (mod.rs); body,
+//!                force and joint edits (bodies.rs, forces.rs, joints.rs); ray casts,
+//!                shape casts and overlaps (query.rs); World::step, its stages and the
+//!                step context (step.rs)
+//! contact_cache  persistent manifolds: broad and narrow phase into warm-started contacts
+//! speculative    speculative contacts the step will not reach (no ghost collisions)
+//! ccd            sweeps of fast bodies back to their time of impact
+//! diagnostics    energies, momenta, state hash
+//! analysis       convergence order, energy behaviour, stability of the integrators
+//! ```
+
+pub mod analysis;
+pub(crate) mod ccd;
+pub mod contact_cache;
+pub mod diagnostics;
+pub(crate) mod speculative;
+pub mod world;

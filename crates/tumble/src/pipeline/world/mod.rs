@@ -1,0 +1,346 @@
+//! The world: its lasting state, in a few named stores, and the edits and reads of it.
+//!
+//! What a world *is* between two steps, and so what a snapshot must keep, is exactly the
+//! fields of [`World`] other than `scratch`:
+//!
+//! | store       | holds                                                                  |
+//! |-------------|------------------------------------------------------------------------|
+//! | `settings`  | gravity, integrator, solver settings, tolerances (from `length_unit`), sleeping on/off |
+//! | `clock`     | simulated time, steps taken                                            |
+//! | `bodies`    | bodies in creation order (state x, q, v, L, ω; awake, sleep timer, island tag) and their generational handles |
+//! | `forces`    | force elements with their handles, force callbacks (code: not data)    |
+//! | `joints`    | joints (with warm-start impulses, reactions, broken flag) and their handles; each joint's bodies and the pairs joints keep from colliding are re-derived every step |
+//! | `collision` | the broad phase (trees, fat boxes, pair set), one proxy per body, the contact cache (manifolds with warm starts and friction anchors, events) |
+//! | `islands`   | the sleep tag counter (islands' membership lives in the bodies' tags)  |
+//! | `memory`    | the integrator's memory (Störmer–Verlet's previous positions)          |
+//!
+//! `scratch` ([`StepContext`]) is what one step builds and throws away; it is kept only so
+//! that stepping allocates nothing, and nothing in it is read before a step writes it.
+//! The step itself is in `step.rs`; body, force and joint edits in `bodies.rs`,
+//! `forces.rs` and `joints.rs`; queries in `query.rs`.
+
+mod bodies;
+mod forces;
+mod joints;
+pub mod query;
+pub(crate) mod step;
+
+use crate::collision::broad_phase::{BroadPhase, ProxyId};
+use crate::collision::contact::{Contact, ContactEvent};
+use crate::dynamics::body::Body;
+use crate::dynamics::force::{Force, ForceCallback};
+use crate::dynamics::integrate::{Integrator, IntegratorMemory};
+use crate::dynamics::joint::{Joint, JointId};
+use crate::dynamics::solver::{Scales, SolverSettings};
+use crate::error::{check, Error, Result};
+use crate::handles::Handles;
+use crate::id::{BodyId, ForceId};
+use crate::math::{Real, Vec3};
+use crate::pipeline::contact_cache::ContactCache;
+use crate::pipeline::diagnostics::{self, Diagnostics};
+use step::StepContext;
+
+/// World settings; `Default` is the seed's: g = 9.8 m/s² down the y axis, symplectic Euler.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WorldDef {
+    /// Gravitational acceleration (m/s²).
+    pub gravity: Vec3,
+    /// The time-stepping method.
+    pub integrator: Integrator,
+    /// The length scale of the scene (m): 1 for a scene in metres, 0.01 for one built in
+    /// centimetres. Every tolerance (speculative distance, slop, sleep and bounce
+    /// thresholds, broad-phase margins) is this times its value for metres, so a scene
+    /// behaves the same at any scale.
+    pub length_unit: Real,
+    /// The contact solver.
+    pub solver: SolverSettings,
+    /// Whether resting islands may fall asleep (they wake on any disturbance).
+    pub sleep: bool,
+}
+
+impl Default for WorldDef {
+    fn default() -> Self {
+        WorldDef {
+            gravity: Vec3::new(0.0, -9.8, 0.0),
+            integrator: Integrator::default(),
+            length_unit: 1.0,
+            solver: SolverSettings::default(),
+            sleep: true,
+        }
+    }
+}
+
+/// Tolerances for a scene whose lengths are in multiples of `length_unit` metres; the
+/// figures are Box2D v3's, which are tuned for metres.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Tolerances {
+    /// Speculative contact distance: gaps narrower than this are contacts already.
+    pub contact_margin: Real,
+    /// How far the broad phase enlarges each box, so slow bodies are not reinserted.
+    pub aabb_margin: Real,
+    /// Solver scales (slop, push-out speed, restitution threshold).
+    pub scales: Scales,
+    /// Speed below which a body counts as resting (m/s).
+    pub sleep_speed: Real,
+}
+
+impl Tolerances {
+    pub(crate) fn new(length_unit: Real) -> Tolerances {
+        let slop = 0.005 * length_unit;
+        Tolerances {
+            contact_margin: 4.0 * slop,
+            aabb_margin: 0.1 * length_unit,
+            scales: Scales {
+                linear_slop: slop,
+                max_push: 3.0 * length_unit,
+                restitution_threshold: 1.0 * length_unit,
+            },
+            sleep_speed: 0.05 * length_unit,
+        }
+    }
+}
+
+/// The world's settings: what the user chose, and the tolerances derived from it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Settings {
+    pub gravity: Vec3,
+    pub integrator: Integrator,
+    pub tolerances: Tolerances,
+    pub solver: SolverSettings,
+    pub sleep: bool,
+}
+
+/// Simulated time (s) and the number of steps taken.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Clock {
+    pub time: Real,
+    pub steps: u64,
+}
+
+/// The bodies, dense in creation order, behind generational handles.
+#[derive(Default)]
+pub(crate) struct BodyStore {
+    pub list: Vec<Body>,
+    pub handles: Handles<BodyId>,
+}
+
+impl BodyStore {
+    /// The dense index of the live body `id`.
+    pub fn dense(&self, id: BodyId) -> Option<usize> {
+        self.handles.dense(id)
+    }
+
+    /// Each dense body's handle.
+    pub fn ids(&self) -> &[BodyId] {
+        self.handles.ids()
+    }
+}
+
+/// Force elements in creation order with their handles, and the force callbacks.
+#[derive(Default)]
+pub(crate) struct ForceStore {
+    pub list: Vec<Force>,
+    pub handles: Handles<ForceId>,
+    pub callbacks: Vec<ForceCallback>,
+}
+
+/// Joints in creation order with their handles (see `joints.rs`), and what each
+/// step re-derives of them before anything reads it.
+#[derive(Default)]
+pub(crate) struct JointStore {
+    pub list: Vec<Joint>,
+    pub handles: Handles<JointId>,
+    /// Each joint's bodies as dense indices (`None`: the world, or a broken joint).
+    pub links: Vec<[Option<usize>; 2]>,
+    /// Dense body pairs a joint keeps from colliding, sorted.
+    pub joined_pairs: Vec<(u32, u32)>,
+}
+
+/// What collision detection keeps between steps.
+pub(crate) struct CollisionStore {
+    pub broad_phase: BroadPhase,
+    /// One broad-phase proxy per body, in body order.
+    pub proxies: Vec<ProxyId>,
+    pub contacts: ContactCache,
+}
+
+/// A simulated world. See the module documentation for what each store holds.
+pub struct World {
+    pub(crate) settings: Settings,
+    pub(crate) clock: Clock,
+    pub(crate) bodies: BodyStore,
+    pub(crate) forces: ForceStore,
+    pub(crate) joints: JointStore,
+    pub(crate) collision: CollisionStore,
+    /// The islands' tag counter (see `dynamics/island.rs`).
+    pub(crate) sleep_tag: u32,
+    pub(crate) memory: IntegratorMemory,
+    /// Scratch of one step (see `step.rs`): not part of the world's state.
+    pub(crate) scratch: StepContext,
+}
+
+impl World {
+    /// An empty world, after checking the definition.
+    pub fn try_new(def: &WorldDef) -> Result<World> {
+        check::vec3("gravity", def.gravity)?;
+        check::positive("length_unit", def.length_unit)?;
+        let mut world = World::new(def);
+        world.set_solver_settings(def.solver)?;
+        Ok(world)
+    }
+
+    /// An empty world. A non-positive or non-finite `length_unit` is taken as 1 m; use
+    /// [`World::try_new`] to have bad settings refused instead.
+    pub fn new(def: &WorldDef) -> World {
+        let unit = if def.length_unit.is_finite() && def.length_unit > 0.0 {
+            def.length_unit
+        } else {
+            1.0
+        };
+        let tolerances = Tolerances::new(unit);
+        World {
+            settings: Settings {
+                gravity: def.gravity,
+                integrator: def.integrator,
+                tolerances,
+                solver: def.solver,
+                sleep: def.sleep,
+            },
+            clock: Clock::default(),
+            bodies: BodyStore::default(),
+            forces: ForceStore::default(),
+            joints: JointStore::default(),
+            collision: CollisionStore {
+                broad_phase: BroadPhase::new(tolerances.aabb_margin),
+                proxies: Vec::new(),
+                contacts: ContactCache::default(),
+            },
+            sleep_tag: 0,
+            memory: IntegratorMemory::default(),
+            scratch: StepContext::default(),
+        }
+    }
+
+    /// Turns sleeping on or off; turning it off wakes everything.
+    pub fn set_sleep_enabled(&mut self, enabled: bool) {
+        self.settings.sleep = enabled;
+        if !enabled {
+            self.wake_all();
+        }
+    }
+
+    /// Whether resting islands may fall asleep.
+    pub fn sleep_enabled(&self) -> bool {
+        self.settings.sleep
+    }
+
+    /// Gravitational acceleration (m/s²).
+    pub fn gravity(&self) -> Vec3 {
+        self.settings.gravity
+    }
+
+    /// Changes gravity.
+    pub fn set_gravity(&mut self, gravity: Vec3) -> Result<()> {
+        check::vec3("gravity", gravity)?;
+        if gravity != self.settings.gravity {
+            self.wake_all();
+        }
+        self.settings.gravity = gravity;
+        Ok(())
+    }
+
+    /// The time-stepping method.
+    pub fn integrator(&self) -> Integrator {
+        self.settings.integrator
+    }
+
+    /// Changes the time-stepping method from the next step on. The old method's memory
+    /// (Störmer–Verlet's previous positions) is forgotten: a method switched back to
+    /// starts afresh, as in a new world from the same state.
+    pub fn set_integrator(&mut self, integrator: Integrator) {
+        if integrator != self.settings.integrator {
+            self.memory.clear();
+        }
+        self.settings.integrator = integrator;
+    }
+
+    /// Simulated time (s).
+    pub fn time(&self) -> Real {
+        self.clock.time
+    }
+
+    /// Steps taken.
+    pub fn step_count(&self) -> u64 {
+        self.clock.steps
+    }
+
+    /// Speculative contact distance (m).
+    pub fn contact_margin(&self) -> Real {
+        self.settings.tolerances.contact_margin
+    }
+
+    /// The solver settings.
+    pub fn solver_settings(&self) -> SolverSettings {
+        self.settings.solver
+    }
+
+    /// Changes the solver settings from the next step on.
+    pub fn set_solver_settings(&mut self, settings: SolverSettings) -> Result<()> {
+        if settings.substeps == 0 {
+            return Err(Error::invalid("substeps", "must be >= 1"));
+        }
+        if settings.iterations == 0 {
+            return Err(Error::invalid("iterations", "must be >= 1"));
+        }
+        check::positive("contact_hertz", settings.contact_hertz)?;
+        check::non_negative("contact_damping_ratio", settings.contact_damping_ratio)?;
+        check::non_negative("baumgarte", settings.baumgarte)?;
+        check::positive("joint_hertz", settings.joint_hertz)?;
+        check::non_negative("joint_damping_ratio", settings.joint_damping_ratio)?;
+        self.settings.solver = settings;
+        Ok(())
+    }
+
+    /// Runs the broad and narrow phases on the current state and returns every contact
+    /// manifold; points keep last update's impulses where their feature ids match.
+    pub fn update_contacts(&mut self) -> &[Contact] {
+        let c = &mut self.collision;
+        c.contacts.update(
+            &mut c.broad_phase,
+            &self.bodies.list,
+            self.bodies.ids(),
+            self.settings.tolerances.contact_margin,
+            &self.joints.joined_pairs,
+        );
+        c.contacts.contacts()
+    }
+
+    /// The contacts of the last step (or [`World::update_contacts`]), with the normal and
+    /// friction impulses the solver applied at each point (N·s, per substep).
+    pub fn contacts(&self) -> &[Contact] {
+        self.collision.contacts.contacts()
+    }
+
+    /// Pairs that started or stopped touching at the last contact update (each step
+    /// runs one), plus end events for bodies removed since.
+    pub fn contact_events(&self) -> &[ContactEvent] {
+        self.collision.contacts.events()
+    }
+
+    /// Energies and momenta of the current state.
+    pub fn diagnostics(&self) -> Diagnostics {
+        let find = |id: BodyId| self.bodies.dense(id);
+        let bodies = &self.bodies.list;
+        let motions: Vec<_> = bodies
+            .iter()
+            .map(crate::dynamics::body::Motion::of)
+            .collect();
+        let gravity = self.settings.gravity;
+        diagnostics::measure(gravity, bodies, &self.forces.list, &motions, &find)
+    }
+
+    /// A hash of every body's state bits: equal hashes mean bit-identical states.
+    pub fn state_hash(&self) -> u64 {
+        diagnostics::state_hash(&self.bodies.list)
+    }
+}
