@@ -309,24 +309,27 @@ fn solve_normal<W: Wide, const BIAS: bool>(
     let (zero, one) = (W::splat(0.0), W::splat(1.0));
     let sep = moved.gap(p.separation, p.ra, p.rb, p.lever);
     let speculative = sep.greater(zero);
-    let (velocity_bias, mass_scale, impulse_scale) = speculative.choose(
-        #[inline(always)]
-        || (sep * W::splat(rule.inv_h), one, zero),
-        #[inline(always)]
-        || {
-            if BIAS {
-                let soft = &rule.softness;
+    let closing = sep * W::splat(rule.inv_h);
+    // Without bias the scales stay constants (not blends of equal values), so that the
+    // relax pass's lanes multiply by 1 no more than the scalar code does.
+    let (velocity_bias, mass_scale, impulse_scale) = if BIAS {
+        let soft = &rule.softness;
+        speculative.choose(
+            #[inline(always)]
+            || (closing, one, zero),
+            #[inline(always)]
+            || {
                 let error = (sep + W::splat(rule.slop)).min(zero);
                 (
                     (W::splat(soft.bias_rate) * error).max(W::splat(-rule.max_push)),
                     W::splat(soft.mass_scale),
                     W::splat(soft.impulse_scale),
                 )
-            } else {
-                (zero, one, zero)
-            }
-        },
-    );
+            },
+        )
+    } else {
+        (speculative.pick(closing, zero), one, zero)
+    };
     let vn = p.normal.velocity(f.normal, p.ra, p.rb, s);
     let delta =
         -p.normal.mass * mass_scale * (vn + velocity_bias) - impulse_scale * p.normal_impulse;
