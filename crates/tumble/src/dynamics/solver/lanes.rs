@@ -11,6 +11,7 @@
 
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
+use super::wide::{Blend, LaneMask, Vector, Wide};
 use crate::math::{Real, Vec3};
 
 /// Number of lanes. A group's updates form one dependent chain through its bodies'
@@ -309,6 +310,91 @@ impl Sub for Lanes3 {
             y: self.y - rhs.y,
             z: self.z - rhs.z,
         }
+    }
+}
+
+/// The eight-lane kind of the rows' arithmetic (see `super::wide`): each operation is
+/// the lane loop above, so lane by lane the `Real` one.
+impl Wide for Lanes {
+    type Mask = Mask;
+    type V3 = Lanes3;
+
+    #[inline(always)]
+    fn splat(x: Real) -> Lanes {
+        Lanes::splat(x)
+    }
+    #[inline(always)]
+    fn max(self, rhs: Lanes) -> Lanes {
+        Lanes::max(self, rhs)
+    }
+    #[inline(always)]
+    fn min(self, rhs: Lanes) -> Lanes {
+        Lanes::min(self, rhs)
+    }
+    #[inline(always)]
+    fn clamp(self, lo: Lanes, hi: Lanes) -> Lanes {
+        Lanes::clamp(self, lo, hi)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Lanes {
+        Lanes::sqrt(self)
+    }
+    #[inline(always)]
+    fn greater(self, rhs: Lanes) -> Mask {
+        self.gt(rhs)
+    }
+    #[inline(always)]
+    fn at_most(self, rhs: Lanes) -> Mask {
+        self.le(rhs)
+    }
+    #[inline(always)]
+    fn equals(self, rhs: Lanes) -> Mask {
+        Lanes::eq(self, rhs)
+    }
+}
+
+impl Vector<Lanes> for Lanes3 {
+    #[inline(always)]
+    fn new(x: Lanes, y: Lanes, z: Lanes) -> Lanes3 {
+        Lanes3 { x, y, z }
+    }
+    #[inline(always)]
+    fn dot(self, rhs: Lanes3) -> Lanes {
+        Lanes3::dot(self, rhs)
+    }
+    #[inline(always)]
+    fn cross(self, rhs: Lanes3) -> Lanes3 {
+        Lanes3::cross(self, rhs)
+    }
+    #[inline(always)]
+    fn scale(self, k: Lanes) -> Lanes3 {
+        Lanes3::scale(self, k)
+    }
+}
+
+/// Lanes evaluate both branches and keep each lane's pick (see `super::wide`).
+impl LaneMask for Mask {
+    #[inline(always)]
+    fn any(self) -> bool {
+        Mask::any(self)
+    }
+    #[inline(always)]
+    fn choose<T: Blend<Mask>>(self, yes: impl FnOnce() -> T, no: impl FnOnce() -> T) -> T {
+        T::blend(self, yes(), no())
+    }
+}
+
+impl Blend<Mask> for Lanes {
+    #[inline(always)]
+    fn blend(mask: Mask, yes: Lanes, no: Lanes) -> Lanes {
+        mask.select(yes, no)
+    }
+}
+
+impl Blend<Mask> for Lanes3 {
+    #[inline(always)]
+    fn blend(mask: Mask, yes: Lanes3, no: Lanes3) -> Lanes3 {
+        mask.select3(yes, no)
     }
 }
 

@@ -23,7 +23,9 @@ mod joint;
 mod lanes;
 mod mass_ratio;
 mod restitution;
+mod rows;
 mod softness;
+mod wide;
 
 pub use softness::Softness;
 
