@@ -33,7 +33,7 @@ pub use error::{printable, Result, SceneError};
 pub use force::FORCE_TYPES;
 pub use joint::JOINT_TYPES;
 pub use plan::{RunPlan, MAX_STEPS};
-pub use reader::ROOT;
+pub use reader::{whole_rule, ROOT};
 pub use shape::SHAPE_TYPES;
 
 use reader::{Node, Obj};
@@ -58,6 +58,9 @@ const TOP_KEYS: [&str; 18] = [
     "length_unit",
     "sleep",
 ];
+
+/// The most `substeps` and `iterations` a scene or the command line may ask for.
+pub const MAX_PASSES: u32 = 1_000_000;
 
 /// Default step (s).
 pub const DEFAULT_DT: Real = 0.01;
@@ -207,10 +210,11 @@ pub fn parse_solver(name: &str) -> Result<SolverKind> {
 /// checked by the engine (`World::try_new`), which names the same keys.
 fn solver_settings(obj: &Obj<'_>) -> Result<SolverSettings> {
     let d = SolverSettings::default();
+    // Checked here rather than by the engine, so that 0 and -1 are told the same rule.
     let count = |key: &str, default: u32| -> Result<u32> {
         Ok(obj
             .get(key)
-            .map(|n| n.whole(1_000_000))
+            .map(|n| n.whole_in(1, MAX_PASSES.into()))
             .transpose()?
             .map_or(default, |v| v as u32))
     };

@@ -9,6 +9,16 @@ use crate::error::{printable, Result, SceneError};
 /// The field named by errors about the document as a whole (unreadable, malformed JSON).
 pub const ROOT: &str = "scene";
 
+/// The rule a whole number in [`min`, `max`] breaks, in the words of every message about
+/// one: scene keys and command-line options alike. `u64::MAX` stands for no upper bound.
+pub fn whole_rule(min: u64, max: u64) -> String {
+    if max == u64::MAX {
+        format!("must be a whole number >= {min}")
+    } else {
+        format!("must be a whole number from {min} to {max}")
+    }
+}
+
 /// A JSON value and its path in the scene.
 #[derive(Clone)]
 pub(crate) struct Node<'a> {
@@ -84,6 +94,16 @@ impl<'a> Node<'a> {
             Some(_) => Err(self.err(format!("must be at most {max}"))),
             None => Err(self.err("must be a whole number >= 0")),
         }
+    }
+
+    /// A whole number in [`min`, `max`] (solver passes). Every other value, `0` and `-1`
+    /// and `1.5` alike, is told the same rule, [`whole_rule`].
+    pub fn whole_in(&self, min: u64, max: u64) -> Result<u64> {
+        match self.value {
+            Value::Number(n) => n.as_u64().filter(|v| (min..=max).contains(v)),
+            _ => None,
+        }
+        .ok_or_else(|| self.err(whole_rule(min, max)))
     }
 
     /// A string.
