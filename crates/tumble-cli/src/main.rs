@@ -2,9 +2,11 @@
 //!
 //! Exit status: 0 on success; 2 for bad input (command-line options, scene files, output
 //! paths that cannot be created), with one line on stderr naming the offending field, e.g.
-//! `bodies[3].shape.radius: must be > 0`; 1 when a run fails part way (a write error).
+//! `bodies[3].shape.radius: must be > 0` (clap's refusals included); 1 when a run fails
+//! part way (a write error).
 
 mod analyze;
+mod args;
 mod contacts;
 mod plot;
 mod progress;
@@ -101,8 +103,14 @@ pub fn stdout_failure(e: io::Error) -> Failure {
 }
 
 fn main() -> ExitCode {
-    // clap prints its own errors and help and exits (2 for errors, 0 for --help).
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => match args::refusal(e) {
+            // Help and version as clap prints them, with its exit status (0).
+            args::Refusal::Show(e) => e.exit(),
+            args::Refusal::Line(line) => return fail(&line, 2),
+        },
+    };
     let command = cli.command.unwrap_or_else(|| Command::Run(Box::default()));
     let result = match command {
         Command::Run(args) => run::run(&args),

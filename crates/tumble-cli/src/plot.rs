@@ -29,12 +29,17 @@ pub struct PlotArgs {
     pub columns: Option<String>,
 
     /// Picture width in pixels.
-    #[arg(long, value_name = "PX", default_value_t = 900)]
+    #[arg(long, value_name = "PX", default_value_t = 900, allow_negative_numbers = true, value_parser = pixels)]
     pub width: u32,
 
     /// Picture height in pixels.
-    #[arg(long, value_name = "PX", default_value_t = 640)]
+    #[arg(long, value_name = "PX", default_value_t = 640, allow_negative_numbers = true, value_parser = pixels)]
     pub height: u32,
+}
+
+/// `--width`, `--height`.
+fn pixels(text: &str) -> Result<u32, String> {
+    crate::args::whole_u32(text, 100, 8192)
 }
 
 /// The header and the columns of a CSV file of numbers.
@@ -77,11 +82,6 @@ fn read_csv(args: &PlotArgs) -> Result<(Vec<String>, Vec<Vec<f64>>), Failure> {
 
 /// Runs the command.
 pub fn plot(args: &PlotArgs) -> Result<(), Failure> {
-    for (field, px) in [("width", args.width), ("height", args.height)] {
-        if !(100..=8192).contains(&px) {
-            return Err(SceneError::new(field, "must be between 100 and 8192 pixels").into());
-        }
-    }
     if args
         .out
         .extension()

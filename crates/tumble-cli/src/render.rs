@@ -10,6 +10,7 @@ use tumble::Real;
 use tumble_render::{Camera, Encoder, Model, Output, Overlays, Renderer, Rgb, Snapshot};
 use tumble_scene::{printable, RunPlan, SceneError};
 
+use crate::args::{number, whole_u32};
 use crate::progress::Progress;
 use crate::sample::{frame_count, run_frames};
 use crate::Failure;
@@ -32,7 +33,7 @@ pub struct RenderArgs {
     pub out: PathBuf,
 
     /// Simulated time to show, in seconds (s); default: the scene's `duration`.
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = number)]
     pub duration: Option<Real>,
 
     /// Frames per second of simulated time (and of playback).
@@ -40,16 +41,17 @@ pub struct RenderArgs {
         long,
         value_name = "N",
         default_value_t = 30.0,
-        allow_negative_numbers = true
+        allow_negative_numbers = true,
+        value_parser = number
     )]
     pub fps: Real,
 
     /// Picture width in pixels.
-    #[arg(long, value_name = "PX", default_value_t = 480)]
+    #[arg(long, value_name = "PX", default_value_t = 480, allow_negative_numbers = true, value_parser = pixels)]
     pub width: u32,
 
     /// Picture height in pixels.
-    #[arg(long, value_name = "PX", default_value_t = 360)]
+    #[arg(long, value_name = "PX", default_value_t = 360, allow_negative_numbers = true, value_parser = pixels)]
     pub height: u32,
 
     /// Eye position x,y,z (m, world frame). Default: framing every moving body over the
@@ -90,6 +92,11 @@ pub fn parse_point(field: &str, text: &str) -> Result<Vec3, SceneError> {
     }
 }
 
+/// `--width`, `--height`.
+fn pixels(text: &str) -> Result<u32, String> {
+    whole_u32(text, 16, 8192)
+}
+
 /// The options checked before anything runs.
 struct Checked {
     output: Output,
@@ -102,11 +109,6 @@ struct Checked {
 fn check(args: &RenderArgs, scene: &tumble_scene::Scene) -> Result<Checked, Failure> {
     if !(args.fps > 0.0 && args.fps <= 1000.0) {
         return Err(SceneError::new("fps", "must be > 0 and <= 1000").into());
-    }
-    for (field, px) in [("width", args.width), ("height", args.height)] {
-        if !(16..=8192).contains(&px) {
-            return Err(SceneError::new(field, "must be between 16 and 8192 pixels").into());
-        }
     }
     let output = Output::from_path(&args.out).map_err(|e| SceneError::new("out", e))?;
     let plan = RunPlan::from_duration(args.duration.unwrap_or(scene.duration), scene.dt)?;

@@ -4,8 +4,9 @@ use std::path::PathBuf;
 
 use clap::Args;
 use tumble::{Real, World};
-use tumble_scene::{RunPlan, Scene, SceneError};
+use tumble_scene::{RunPlan, Scene, SceneError, MAX_PASSES, MAX_STEPS};
 
+use crate::args::{number, whole, whole_u32};
 use crate::record::{
     CsvFile, CONTACT_IMPULSES_HEADER, DIAGNOSTICS_HEADER, JOINT_REACTIONS_HEADER, TRAJECTORY_HEADER,
 };
@@ -28,15 +29,21 @@ pub struct RunArgs {
     pub scene: Option<String>,
 
     /// Simulated time to run, in seconds (s); overrides the scene's `duration`.
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = number)]
     pub duration: Option<Real>,
 
     /// Number of steps of dt to take, instead of --duration.
-    #[arg(long, value_name = "N", conflicts_with = "duration")]
+    #[arg(
+        long,
+        value_name = "N",
+        conflicts_with = "duration",
+        allow_negative_numbers = true,
+        value_parser = |t: &str| whole(t, 0, MAX_STEPS)
+    )]
     pub steps: Option<u64>,
 
     /// Time step, in seconds (s); overrides the scene's `dt`. Must be > 0.
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = number)]
     pub dt: Option<Real>,
 
     /// Integration method; overrides the scene's `integrator`. One of: explicit_euler,
@@ -75,16 +82,22 @@ pub struct RunArgs {
     pub solver: Option<String>,
 
     /// Solver substeps per step; overrides the scene's `substeps`.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = passes)]
     pub substeps: Option<u32>,
 
     /// Solver iterations per substep; overrides the scene's `iterations`.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = passes)]
     pub iterations: Option<u32>,
 
     /// Record every K-th step in the CSV files; step 0 and the last step are always
     /// recorded.
-    #[arg(long, value_name = "K", default_value_t = 1)]
+    #[arg(
+        long,
+        value_name = "K",
+        default_value_t = 1,
+        allow_negative_numbers = true,
+        value_parser = |t: &str| whole(t, 1, u64::MAX)
+    )]
     pub every: u64,
 
     /// Print nothing on standard output and show no progress bar (errors still go to
@@ -116,9 +129,6 @@ impl Default for RunArgs {
 
 /// Runs the command.
 pub fn run(args: &RunArgs) -> Result<(), Failure> {
-    if args.every == 0 {
-        return Err(SceneError::new("every", "must be >= 1").into());
-    }
     let integrator = args
         .integrator
         .as_deref()
@@ -163,6 +173,11 @@ fn plan(args: &RunArgs, scene: &Scene) -> Result<RunPlan, SceneError> {
         Some(steps) => RunPlan::from_steps(steps, dt),
         None => RunPlan::from_duration(args.duration.unwrap_or(scene.duration), dt),
     }
+}
+
+/// `--substeps`, `--iterations`: the scene format's rule for its keys of the same names.
+fn passes(text: &str) -> Result<u32, String> {
+    whole_u32(text, 1, MAX_PASSES)
 }
 
 /// Steps the world through `plan`, showing step 0, every `every`-th step and the last to

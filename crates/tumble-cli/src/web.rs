@@ -13,6 +13,7 @@ use tumble_render::mesh::Geometry;
 use tumble_render::{Camera, Model, Rgb, Snapshot, BACKGROUND};
 use tumble_scene::{printable, RunPlan, Scene, SceneError};
 
+use crate::args::{number, whole};
 use crate::progress::Progress;
 use crate::sample::{frame_count, run_frames};
 use crate::Failure;
@@ -32,7 +33,7 @@ pub struct PageArgs {
     pub scene: String,
 
     /// Simulated time to record, in seconds (s); default: the scene's `duration`.
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = number)]
     pub duration: Option<Real>,
 
     /// Frames recorded per second of simulated time.
@@ -40,7 +41,8 @@ pub struct PageArgs {
         long,
         value_name = "N",
         default_value_t = 30.0,
-        allow_negative_numbers = true
+        allow_negative_numbers = true,
+        value_parser = number
     )]
     pub fps: Real,
 
@@ -68,7 +70,12 @@ pub struct ViewArgs {
     pub page: PageArgs,
 
     /// Port on 127.0.0.1 to serve on; 0 picks a free one.
-    #[arg(long, default_value_t = 0)]
+    #[arg(
+        long,
+        default_value_t = 0,
+        allow_negative_numbers = true,
+        value_parser = |t: &str| whole(t, 0, 65535).map(|p| p as u16)
+    )]
     pub port: u16,
 
     /// Do not open a browser; only print the address.
@@ -77,7 +84,7 @@ pub struct ViewArgs {
 
     /// Serve this many requests, then stop (for scripts and tests; default: until
     /// interrupted).
-    #[arg(long, value_name = "N", hide = true)]
+    #[arg(long, value_name = "N", hide = true, value_parser = |t: &str| whole(t, 1, u64::MAX))]
     pub requests: Option<u64>,
 }
 
