@@ -1,43 +1,31 @@
 //! `tumble analyze`: the seed's convergence, order and stability, measured.
 
 use std::io::{self, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
 use tumble_render::plot::{Figure, Panel, Series};
-use tumble_scene::printable;
 
 use tumble::analysis;
 use tumble::Integrator;
 
+use crate::output::{Staged, Target};
 use crate::{stdout_failure, Failure};
 
 /// Options of `tumble analyze`.
 #[derive(Args, Debug, Default)]
 pub struct AnalyzeArgs {
     /// Also draw the convergence measurements as a log-log PNG: phase-space error
-    /// against dt for every integrator, each line labelled with its fitted slope.
+    /// against dt for every integrator, each line labelled with its fitted slope (written
+    /// as FILE.png.partial, renamed when complete).
     #[arg(long, value_name = "FILE.png")]
     pub plot: Option<PathBuf>,
 }
 
 /// Prints one row per integrator as soon as it is measured.
 pub fn analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
-    if let Some(path) = &args.plot {
-        // Refused before minutes of measuring, not after.
-        if path
-            .extension()
-            .is_none_or(|e| !e.eq_ignore_ascii_case("png"))
-        {
-            return Err(Failure::Input("plot: must be a .png file".into()));
-        }
-        std::fs::File::create(path).map_err(|e| {
-            Failure::Input(format!(
-                "plot: cannot create '{}': {e}",
-                printable(&path.display().to_string())
-            ))
-        })?;
-    }
+    // Refused before minutes of measuring, not after.
+    let plot = args.plot.as_deref().map(plot_file).transpose()?;
     let mut series = Vec::new();
     let mut out = io::stdout().lock();
     let header = "Harmonic oscillator x'' = -w^2 x, w = 2*pi rad/s, x0 = 1 m, v0 = 0:\n\
@@ -78,7 +66,7 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
         )
         .map_err(stdout_failure)?;
     }
-    if let Some(path) = &args.plot {
+    if let Some(staged) = plot {
         let figure = Figure {
             x_label: "dt (s)".into(),
             panels: vec![Panel {
@@ -91,16 +79,25 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), Failure> {
             width: 900,
             height: 640,
         };
-        figure.write_png(path).map_err(|e| {
-            Failure::Runtime(format!(
-                "plot: cannot write '{}': {e}",
-                printable(&path.display().to_string())
-            ))
-        })?;
-        writeln!(out, "\nwrote '{}'", printable(&path.display().to_string()))
-            .map_err(stdout_failure)?;
+        figure
+            .write_png(staged.path())
+            .map_err(|e| staged.target().write_error(e))?;
+        let shown = staged.target().shown().to_string();
+        staged.commit()?;
+        writeln!(out, "\nwrote '{shown}'").map_err(stdout_failure)?;
     }
     Ok(())
+}
+
+/// `--plot`: a .png path that can be written, its partial file made now.
+fn plot_file(path: &Path) -> Result<Staged, Failure> {
+    if path
+        .extension()
+        .is_none_or(|e| !e.eq_ignore_ascii_case("png"))
+    {
+        return Err(Failure::Input("plot: must be a .png file".into()));
+    }
+    Ok(Staged::create(Target::file("plot", path)?)?.0)
 }
 
 #[allow(clippy::unnecessary_cast)] // a no-op in the f64 build

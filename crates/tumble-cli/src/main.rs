@@ -1,13 +1,16 @@
 //! `tumble`: run rigid-body scenes from the command line.
 //!
 //! Exit status: 0 on success; 2 for bad input (command-line options, scene files, output
-//! paths that cannot be created), with one line on stderr naming the offending field, e.g.
-//! `bodies[3].shape.radius: must be > 0` (clap's refusals included); 1 when a run fails
-//! part way (a write error).
+//! paths) or an output that cannot be written, with one line on stderr naming the option or
+//! field, e.g. `bodies[3].shape.radius: must be > 0`; 1 when a run fails part way (a step
+//! the engine refuses, such as one that goes unstable), with the engine's one line, e.g.
+//! `step 41 (t = 0.683 s): bodies[7] "pelvis": velocity is not finite`, and every output
+//! file complete up to the last good step.
 
 mod analyze;
 mod args;
 mod contacts;
+mod output;
 mod plot;
 mod progress;
 mod record;
@@ -28,9 +31,17 @@ use clap::{Parser, Subcommand};
     name = "tumble",
     version,
     propagate_version = true,
-    after_help = "Exit status: 0 on success; 2 for bad input (options, scene, output paths), \
-                  with one line on stderr naming the field, e.g. \
-                  `bodies[3].shape.radius: must be > 0`; 1 when a run fails part way."
+    after_help = "Exit status: 0 on success; 2 for bad input (options, scene, output paths) \
+                  or an output that cannot be written, with one line on stderr naming the \
+                  option or field, e.g. `bodies[3].shape.radius: must be > 0`; 1 when a run \
+                  fails part way (a step goes unstable), with one line naming the step, the \
+                  time, the body and the quantity, and every output complete up to the last \
+                  good step.\n\n\
+                  Output files are written as NAME.partial beside NAME and renamed into \
+                  place when complete: a failed or killed command never leaves a \
+                  half-written NAME (nor truncates an existing one); only NAME.partial \
+                  remains after a kill. Devices and fifos (/dev/null, /dev/stdout) are \
+                  written directly. An output may not be the scene file, nor another output."
 )]
 struct Cli {
     /// What to do; with none, `tumble` runs the seed's free-fall example (`tumble run`).
@@ -79,10 +90,13 @@ enum Command {
 /// Why the program stops early.
 #[derive(Debug)]
 pub enum Failure {
-    /// Bad input from the user: options, scene, output paths. Exit status 2.
+    /// Bad input from the user (options, scene, output paths) or an output that cannot be
+    /// written. Exit status 2.
     Input(String),
-    /// A failure during the run, such as a write error. Exit status 1.
+    /// The run failed part way: a step the engine refused. Exit status 1.
     Runtime(String),
+    /// Already reported on standard error; only the exit status is left.
+    Reported(u8),
     /// Standard output was closed (`tumble run | head`): stop quietly.
     Closed,
 }
@@ -98,7 +112,7 @@ pub fn stdout_failure(e: io::Error) -> Failure {
     if e.kind() == io::ErrorKind::BrokenPipe {
         Failure::Closed
     } else {
-        Failure::Runtime(format!("stdout: cannot write: {e}"))
+        Failure::Input(format!("stdout: cannot write: {e}"))
     }
 }
 
@@ -126,6 +140,7 @@ fn main() -> ExitCode {
         Ok(()) | Err(Failure::Closed) => ExitCode::SUCCESS,
         Err(Failure::Input(line)) => fail(&line, 2),
         Err(Failure::Runtime(line)) => fail(&line, 1),
+        Err(Failure::Reported(code)) => ExitCode::from(code),
     }
 }
 

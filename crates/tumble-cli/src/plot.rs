@@ -7,6 +7,7 @@ use clap::Args;
 use tumble_render::plot::{Figure, Panel, Series};
 use tumble_scene::{printable, SceneError};
 
+use crate::output::{check_distinct, Staged, Target};
 use crate::Failure;
 
 /// Columns that are energies (J) and share a panel.
@@ -20,7 +21,7 @@ pub struct PlotArgs {
     #[arg(value_name = "FILE.csv")]
     pub file: PathBuf,
 
-    /// The PNG to write.
+    /// The PNG to write (as FILE.png.partial, renamed when complete).
     #[arg(long, value_name = "FILE.png")]
     pub out: PathBuf,
 
@@ -89,6 +90,8 @@ pub fn plot(args: &PlotArgs) -> Result<(), Failure> {
     {
         return Err(SceneError::new("out", "must be a .png file").into());
     }
+    let target = Target::file("out", &args.out)?;
+    check_distinct(&[&target], &[("file", &args.file)])?;
     let (header, columns) = read_csv(args)?;
     if header.len() < 2 {
         return Err(SceneError::new("file", "needs at least two columns").into());
@@ -146,10 +149,12 @@ pub fn plot(args: &PlotArgs) -> Result<(), Failure> {
         width: args.width,
         height: args.height,
     };
-    let out = printable(&args.out.display().to_string());
+    let (staged, _) = Staged::create(target)?;
     figure
-        .write_png(&args.out)
-        .map_err(|e| Failure::Input(format!("out: cannot write '{out}': {e}")))?;
+        .write_png(staged.path())
+        .map_err(|e| staged.target().write_error(e))?;
+    let out = staged.target().shown().to_string();
+    staged.commit()?;
     writeln!(
         std::io::stdout(),
         "wrote '{out}' ({} columns against {})",

@@ -1,15 +1,12 @@
-//! The CSV files a run writes: the trajectory (`--out`) and the diagnostics
-//! (`--diagnostics`). Numbers are printed so that they read back bit for bit, and the
+//! The CSV files a run writes: the trajectory (`--out`), the diagnostics
+//! (`--diagnostics`), contacts and joints. Numbers are printed so that they read back bit for bit, and the
 //! same run always writes the same bytes.
 
 use std::fmt;
-use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
 
 use tumble::{Real, World};
-use tumble_scene::printable;
 
+use crate::output::{Target, Writer};
 use crate::Failure;
 
 /// Header of the trajectory file.
@@ -54,51 +51,31 @@ impl fmt::Display for Num {
     }
 }
 
-/// A CSV file being written; `field` is the option that named it, for error messages.
+/// A CSV file being written (under its partial name until [`CsvFile::finish`]).
 pub struct CsvFile {
-    field: &'static str,
-    path: PathBuf,
-    out: BufWriter<File>,
+    out: Writer,
     /// Data rows written so far.
     pub rows: u64,
 }
 
 impl CsvFile {
-    /// Creates the file and writes its header. A path that cannot be created is bad input.
-    pub fn create(field: &'static str, path: &Path, header: &str) -> Result<CsvFile, Failure> {
-        let file = File::create(path).map_err(|e| {
-            Failure::Input(format!(
-                "{field}: cannot create '{}': {e}",
-                printable(&path.display().to_string())
-            ))
-        })?;
-        let mut csv = CsvFile {
-            field,
-            path: path.to_path_buf(),
-            out: BufWriter::new(file),
-            rows: 0,
-        };
-        writeln!(csv.out, "{header}").map_err(|e| csv.failure(e))?;
-        Ok(csv)
+    /// Creates the file and writes its header.
+    pub fn create(target: Target, header: &str) -> Result<CsvFile, Failure> {
+        let mut out = Writer::create(target)?;
+        out.write(format_args!("{header}\n"))?;
+        out.flush_if_direct()?;
+        Ok(CsvFile { out, rows: 0 })
     }
 
-    /// The file's path.
-    pub fn path(&self) -> &Path {
-        &self.path
-    }
-
-    fn failure(&self, e: std::io::Error) -> Failure {
-        Failure::Runtime(format!(
-            "{}: cannot write '{}': {e}",
-            self.field,
-            printable(&self.path.display().to_string())
-        ))
+    /// The file's path as it was given.
+    pub fn shown(&self) -> &str {
+        self.out.target().shown()
     }
 
     /// One row: the time, then the other fields already joined by commas.
     fn row(&mut self, time: Real, rest: fmt::Arguments<'_>) -> Result<(), Failure> {
         self.rows += 1;
-        writeln!(self.out, "{},{rest}", Num(time)).map_err(|e| self.failure(e))
+        self.out.write(format_args!("{},{rest}\n", Num(time)))
     }
 
     /// A row per body: label, position of the body frame, orientation, velocities.
@@ -220,9 +197,10 @@ impl CsvFile {
         )
     }
 
-    /// Flushes the buffer; a late write error must not pass silently.
-    pub fn finish(mut self) -> Result<u64, Failure> {
-        self.out.flush().map_err(|e| self.failure(e))?;
+    /// Flushes the buffer and puts the file in place; a late write error must not pass
+    /// silently.
+    pub fn finish(self) -> Result<u64, Failure> {
+        self.out.finish()?;
         Ok(self.rows)
     }
 }

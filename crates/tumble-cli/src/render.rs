@@ -1,16 +1,17 @@
 //! `tumble render SCENE --out FILE`: pictures of a run, with no display and no GPU.
 
-use std::path::PathBuf;
-
 use std::io::Write;
+use std::path::PathBuf;
 
 use clap::Args;
 use glam::Vec3;
 use tumble::Real;
+use tumble_render::encode::frame_name;
 use tumble_render::{Camera, Encoder, Model, Output, Overlays, Renderer, Rgb, Snapshot};
 use tumble_scene::{printable, RunPlan, SceneError};
 
 use crate::args::{number, whole_u32};
+use crate::output::{check_distinct, inputs, scene_file, Staged, StagedFolder, Target};
 use crate::progress::Progress;
 use crate::sample::{frame_count, run_frames};
 use crate::Failure;
@@ -28,7 +29,8 @@ pub struct RenderArgs {
     /// Where to write: FILE.gif (animation), FILE.png (one picture of the state at the end
     /// of --duration; --duration 0 for the initial state), FILE.mp4 (needs ffmpeg on the
     /// PATH), or a folder (a path with no extension, or an existing directory) of numbered
-    /// PNG frames frame_00000.png, frame_00001.png, ...
+    /// PNG frames frame_00000.png, frame_00001.png, ... A file is written as FILE.partial
+    /// and renamed when complete; frames go into FOLDER/frames.partial/ first.
     #[arg(long, value_name = "PATH")]
     pub out: PathBuf,
 
@@ -100,10 +102,11 @@ fn pixels(text: &str) -> Result<u32, String> {
 /// The options checked before anything runs.
 struct Checked {
     output: Output,
+    target: Target,
     plan: RunPlan,
     frames: u64,
     eye: Option<Vec3>,
-    target: Option<Vec3>,
+    look_at: Option<Vec3>,
 }
 
 fn check(args: &RenderArgs, scene: &tumble_scene::Scene) -> Result<Checked, Failure> {
@@ -111,6 +114,11 @@ fn check(args: &RenderArgs, scene: &tumble_scene::Scene) -> Result<Checked, Fail
         return Err(SceneError::new("fps", "must be > 0 and <= 1000").into());
     }
     let output = Output::from_path(&args.out).map_err(|e| SceneError::new("out", e))?;
+    let target = match output {
+        Output::Frames(_) => Target::folder("out", &args.out)?,
+        _ => Target::file("out", &args.out)?,
+    };
+    check_distinct(&[&target], &inputs(&scene_file(&args.scene)))?;
     let plan = RunPlan::from_duration(args.duration.unwrap_or(scene.duration), scene.dt)?;
     let frames = frame_count(&plan, args.fps);
     if frames > MAX_FRAMES && !output.single_frame() {
@@ -120,51 +128,70 @@ fn check(args: &RenderArgs, scene: &tumble_scene::Scene) -> Result<Checked, Fail
         )
         .into());
     }
-    let eye = args
-        .camera
-        .as_deref()
-        .map(|t| parse_point("camera", t))
-        .transpose()?;
-    let target = args
-        .target
-        .as_deref()
-        .map(|t| parse_point("target", t))
-        .transpose()?;
-    if eye.is_some() && eye == target {
+    let point =
+        |field, text: &Option<String>| text.as_deref().map(|t| parse_point(field, t)).transpose();
+    let (eye, look_at) = (
+        point("camera", &args.camera)?,
+        point("target", &args.target)?,
+    );
+    if eye.is_some() && eye == look_at {
         return Err(SceneError::new("camera", "must differ from --target").into());
     }
     Ok(Checked {
         output,
+        target,
         plan,
         frames,
         eye,
-        target,
+        look_at,
     })
 }
 
-/// Runs the command.
+/// Where the pictures go while they are drawn: a partial file, or a folder's staging
+/// folder; created before the run, so that an unwritable path is refused first.
+enum Sink {
+    File(Staged),
+    Folder(StagedFolder),
+}
+
+impl Sink {
+    fn create(target: Target, output: &Output) -> Result<Sink, Failure> {
+        Ok(match output {
+            Output::Frames(_) => Sink::Folder(StagedFolder::create(target)?),
+            _ => Sink::File(Staged::create(target)?.0),
+        })
+    }
+
+    fn target(&self) -> &Target {
+        match self {
+            Sink::File(s) => s.target(),
+            Sink::Folder(f) => f.target(),
+        }
+    }
+
+    fn path(&self) -> &std::path::Path {
+        match self {
+            Sink::File(s) => s.path(),
+            Sink::Folder(f) => f.path(),
+        }
+    }
+
+    fn commit(self, frames: usize) -> Result<(), Failure> {
+        match self {
+            Sink::File(s) => s.commit(),
+            Sink::Folder(f) => f.commit((0..frames).map(frame_name)),
+        }
+    }
+}
+
+/// Runs the command. A step that fails ends the run: the frames up to it are drawn and
+/// written, and the step's account is the error (exit 1).
 pub fn render(args: &RenderArgs) -> Result<(), Failure> {
     let mut scene = tumble_scene::load(&args.scene)?;
     let c = check(args, &scene)?;
+    let sink = Sink::create(c.target.clone(), &c.output)?;
+    let (snapshots, stopped) = simulate(&mut scene.world, args, &c)?;
     let colours: Vec<Option<Rgb>> = scene.body_colors.iter().map(|c| c.map(Rgb)).collect();
-
-    let mut progress = Progress::new(c.plan.steps, "simulating", args.quiet);
-    let mut snapshots = Vec::with_capacity(c.frames.min(MAX_FRAMES) as usize);
-    let keep_all = !c.output.single_frame();
-    run_frames(
-        &mut scene.world,
-        &c.plan,
-        args.fps,
-        &mut progress,
-        |world, k| {
-            if keep_all || k + 1 == c.frames {
-                snapshots.push(Snapshot::capture(world));
-            }
-            Ok(())
-        },
-    )?;
-    progress.finish();
-
     let (camera, scale) = camera(&scene.world, &colours, &snapshots, args, &c);
     let model = Model::new(&scene.world, &colours, scale / 12.0);
     let overlays = Overlays {
@@ -173,38 +200,61 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         time: true,
     };
     let renderer = Renderer::new(model, camera, overlays, scale);
-    let out_failure = |e: std::io::Error| {
-        Failure::Input(format!(
-            "out: cannot write '{}': {e}",
-            printable(&args.out.display().to_string())
-        ))
-    };
-    let mut encoder = Encoder::create(&c.output, args.width, args.height, narrow(args.fps))
-        .map_err(out_failure)?;
+    let failed = |e: std::io::Error| sink.target().write_error(e);
+    let output = c.output.at(sink.path());
+    let mut encoder =
+        Encoder::create(&output, args.width, args.height, narrow(args.fps)).map_err(failed)?;
     let mut progress = Progress::new(snapshots.len() as u64, "drawing", args.quiet);
     for s in &snapshots {
-        encoder.frame(&renderer.render(s)).map_err(out_failure)?;
+        encoder.frame(&renderer.render(s)).map_err(failed)?;
         progress.inc(1);
     }
     progress.finish();
-    encoder.finish().map_err(out_failure)?;
+    encoder.finish().map_err(failed)?;
+    sink.commit(snapshots.len())?;
     if !args.quiet {
-        let what = if c.output.single_frame() {
-            "picture"
-        } else {
-            "frames"
-        };
-        writeln!(
-            std::io::stdout(),
-            "wrote '{}' ({} {what}, {}x{} px)",
-            printable(&args.out.display().to_string()),
-            snapshots.len(),
-            args.width,
-            args.height
-        )
-        .map_err(crate::stdout_failure)?;
+        report(args, &c, snapshots.len())?;
     }
-    Ok(())
+    stopped.map_or(Ok(()), Err)
+}
+
+/// Steps the run and keeps the snapshots to draw: every frame, or for a single picture
+/// the latest (the last good state, if a step fails). The failure of a step, if any,
+/// comes second.
+fn simulate(
+    world: &mut tumble::World,
+    args: &RenderArgs,
+    c: &Checked,
+) -> Result<(Vec<Snapshot>, Option<Failure>), Failure> {
+    let mut progress = Progress::new(c.plan.steps, "simulating", args.quiet);
+    let mut snapshots = Vec::with_capacity(c.frames.min(MAX_FRAMES) as usize);
+    let keep_all = !c.output.single_frame();
+    let stopped = run_frames(world, &c.plan, args.fps, &mut progress, |world, _| {
+        if !keep_all {
+            snapshots.clear();
+        }
+        snapshots.push(Snapshot::capture(world));
+        Ok(())
+    })?;
+    progress.finish();
+    Ok((snapshots, stopped))
+}
+
+/// The line on standard output: what was written.
+fn report(args: &RenderArgs, c: &Checked, frames: usize) -> Result<(), Failure> {
+    let what = if c.output.single_frame() {
+        "picture"
+    } else {
+        "frames"
+    };
+    writeln!(
+        std::io::stdout(),
+        "wrote '{}' ({frames} {what}, {}x{} px)",
+        c.target.shown(),
+        args.width,
+        args.height
+    )
+    .map_err(crate::stdout_failure)
 }
 
 /// The camera the options ask for, or one framing the run; and the size of what is in
@@ -220,7 +270,7 @@ fn camera(
     let bounds = Model::new(world, colours, f32::INFINITY).bounds(snapshots);
     let (min, max) = bounds.unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)));
     let auto = Camera::framing(min, max, args.width, args.height);
-    let target = c.target.unwrap_or(auto.target);
+    let target = c.look_at.unwrap_or(auto.target);
     let eye = c.eye.unwrap_or(target + (auto.eye - auto.target));
     let camera = Camera::look_at(eye, target, args.width, args.height).unwrap_or(auto);
     let scale = (max - min).length().max(0.5);

@@ -7,6 +7,7 @@ use tumble::{Real, World};
 use tumble_scene::{RunPlan, Scene, SceneError, MAX_PASSES, MAX_STEPS};
 
 use crate::args::{number, whole, whole_u32};
+use crate::output::{check_distinct, inputs, scene_file, Target};
 use crate::record::{
     CsvFile, CONTACT_IMPULSES_HEADER, DIAGNOSTICS_HEADER, JOINT_REACTIONS_HEADER, TRAJECTORY_HEADER,
 };
@@ -90,7 +91,7 @@ pub struct RunArgs {
     pub iterations: Option<u32>,
 
     /// Record every K-th step in the CSV files; step 0 and the last step are always
-    /// recorded.
+    /// recorded (and, when a step fails, the last good one).
     #[arg(
         long,
         value_name = "K",
@@ -127,14 +128,16 @@ impl Default for RunArgs {
     }
 }
 
-/// Runs the command.
+/// Runs the command. A step that fails ends the run: the files keep every step up to the
+/// last good one and are put in place, and the step's account is the error (exit 1).
 pub fn run(args: &RunArgs) -> Result<(), Failure> {
     let integrator = args
         .integrator
         .as_deref()
         .map(tumble_scene::parse_integrator)
         .transpose()?;
-    let mut scene = tumble_scene::load(args.scene.as_deref().unwrap_or(SEED_SCENE))?;
+    let scene_name = args.scene.as_deref().unwrap_or(SEED_SCENE);
+    let mut scene = tumble_scene::load(scene_name)?;
     if let Some(integrator) = integrator {
         scene.world.set_integrator(integrator);
     }
@@ -142,7 +145,7 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
     let plan = plan(args, &scene)?;
     let mut sinks = Sinks::open(args, &scene, &plan)?;
     let mut progress = crate::progress::Progress::new(plan.steps, "running", args.quiet);
-    step_all(
+    let stopped = step_all(
         &mut scene.world,
         &plan,
         args.every,
@@ -150,7 +153,8 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
         &mut progress,
     )?;
     progress.finish();
-    sinks.finish(&scene, &plan)
+    sinks.finish(&scene, &plan, stopped.is_none())?;
+    stopped.map_or(Ok(()), Err)
 }
 
 /// `--solver`, `--substeps`, `--iterations` over the scene's settings.
@@ -181,24 +185,29 @@ fn passes(text: &str) -> Result<u32, String> {
 }
 
 /// Steps the world through `plan`, showing step 0, every `every`-th step and the last to
-/// the sinks. A failed step ends the run with its error; nothing is unwrapped.
+/// the sinks. A failed step stops the run: the last good step (the world as it was before
+/// the failed one) is recorded if it was not already, and the step's failure returned.
 fn step_all(
     world: &mut World,
     plan: &RunPlan,
     every: u64,
     sinks: &mut Sinks,
     progress: &mut crate::progress::Progress,
-) -> Result<(), Failure> {
+) -> Result<Option<Failure>, Failure> {
     sinks.observe(0, 0.0, world, true)?;
     for k in 1..=plan.steps {
-        world
-            .step(plan.step_dt(k))
-            .map_err(|e| Failure::Runtime(format!("step {k}: {e}")))?;
+        if let Err(e) = world.step(plan.step_dt(k)) {
+            let good = k - 1;
+            if good % every != 0 {
+                sinks.record(plan.time_after(good), world)?;
+            }
+            return Ok(Some(crate::sample::step_failure(k, e)));
+        }
         let record = k % every == 0 || k == plan.steps;
         sinks.observe(k, plan.time_after(k), world, record)?;
         progress.inc(1);
     }
-    Ok(())
+    Ok(None)
 }
 
 /// Everything that watches the run: the CSV files and the printed reports.
@@ -215,31 +224,31 @@ struct Sinks {
 
 impl Sinks {
     fn open(args: &RunArgs, scene: &Scene, plan: &RunPlan) -> Result<Sinks, Failure> {
-        let files = [&args.out, &args.diagnostics, &args.contacts, &args.joints];
-        for (i, (name, path)) in ["out", "diagnostics", "contacts", "joints"]
-            .iter()
-            .zip(files)
-            .enumerate()
-        {
-            if path.is_some() && files[..i].contains(&path) {
-                return Err(SceneError::new(
-                    *name,
-                    "must be a different file from the other outputs",
-                )
-                .into());
-            }
-        }
-        let csv = |field, path: &Option<PathBuf>, header| {
-            path.as_deref()
-                .map(|p| CsvFile::create(field, p, header))
-                .transpose()
+        // Every path is checked before any file is created, so that a bad one leaves the
+        // others as they were.
+        let check = |field, path: &Option<PathBuf>| {
+            path.as_deref().map(|p| Target::file(field, p)).transpose()
         };
+        let targets = [
+            check("out", &args.out)?,
+            check("diagnostics", &args.diagnostics)?,
+            check("contacts", &args.contacts)?,
+            check("joints", &args.joints)?,
+        ];
+        let scene_file = args.scene.as_deref().and_then(scene_file);
+        check_distinct(
+            &targets.iter().flatten().collect::<Vec<_>>(),
+            &inputs(&scene_file),
+        )?;
+        let [out, diagnostics, contacts, joints] = targets;
+        let csv =
+            |target: Option<Target>, header| target.map(|t| CsvFile::create(t, header)).transpose();
         let seed = args.scene.is_none() && !args.quiet;
         Ok(Sinks {
-            trajectory: csv("out", &args.out, TRAJECTORY_HEADER)?,
-            diagnostics: csv("diagnostics", &args.diagnostics, DIAGNOSTICS_HEADER)?,
-            contacts: csv("contacts", &args.contacts, CONTACT_IMPULSES_HEADER)?,
-            joints: csv("joints", &args.joints, JOINT_REACTIONS_HEADER)?,
+            trajectory: csv(out, TRAJECTORY_HEADER)?,
+            diagnostics: csv(diagnostics, DIAGNOSTICS_HEADER)?,
+            contacts: csv(contacts, CONTACT_IMPULSES_HEADER)?,
+            joints: csv(joints, JOINT_REACTIONS_HEADER)?,
             seed_table: seed
                 .then(|| SeedTable::new(&scene.world, plan))
                 .transpose()?,
@@ -253,18 +262,7 @@ impl Sinks {
     /// files take this step.
     fn observe(&mut self, k: u64, time: Real, world: &World, record: bool) -> Result<(), Failure> {
         if record {
-            if let Some(csv) = &mut self.trajectory {
-                csv.trajectory(time, world, &self.labels)?;
-            }
-            if let Some(csv) = &mut self.diagnostics {
-                csv.diagnostics(time, world)?;
-            }
-            if let Some(csv) = &mut self.contacts {
-                csv.contacts(time, world, &self.labels)?;
-            }
-            if let Some(csv) = &mut self.joints {
-                csv.joints(time, world, &self.labels)?;
-            }
+            self.record(time, world)?;
         }
         if let Some(table) = &mut self.seed_table {
             table.observe(k, time, world)?;
@@ -272,7 +270,26 @@ impl Sinks {
         Ok(())
     }
 
-    fn finish(self, scene: &Scene, plan: &RunPlan) -> Result<(), Failure> {
+    /// A row (or rows) of every CSV file for the state at `time`.
+    fn record(&mut self, time: Real, world: &World) -> Result<(), Failure> {
+        if let Some(csv) = &mut self.trajectory {
+            csv.trajectory(time, world, &self.labels)?;
+        }
+        if let Some(csv) = &mut self.diagnostics {
+            csv.diagnostics(time, world)?;
+        }
+        if let Some(csv) = &mut self.contacts {
+            csv.contacts(time, world, &self.labels)?;
+        }
+        if let Some(csv) = &mut self.joints {
+            csv.joints(time, world, &self.labels)?;
+        }
+        Ok(())
+    }
+
+    /// Puts the files in place, then reports; the seed table's last line and the summary
+    /// only for a run that `completed`.
+    fn finish(self, scene: &Scene, plan: &RunPlan, completed: bool) -> Result<(), Failure> {
         let mut written = Vec::new();
         for csv in [
             self.trajectory,
@@ -283,14 +300,16 @@ impl Sinks {
         .into_iter()
         .flatten()
         {
-            let path = csv.path().display().to_string();
+            let path = csv.shown().to_string();
             written.push((path, csv.finish()?));
         }
-        if let Some(table) = self.seed_table {
-            table.finish(&scene.world, plan)?;
-        }
-        if let Some(summary) = self.summary {
-            summary.print(scene, plan)?;
+        if completed {
+            if let Some(table) = self.seed_table {
+                table.finish(&scene.world, plan)?;
+            }
+            if let Some(summary) = self.summary {
+                summary.print(scene, plan)?;
+            }
         }
         if self.quiet {
             return Ok(());

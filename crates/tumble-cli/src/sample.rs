@@ -13,22 +13,24 @@ pub fn frame_count(plan: &RunPlan, fps: Real) -> u64 {
 }
 
 /// Steps `world` through `plan`, calling `frame(world, k)` for frame k = 0, 1, ... at the
-/// step nearest to k / fps s. Frames past the last step show the final state.
+/// step nearest to k / fps s. Frames past the last step show the final state. A step that
+/// fails stops the run with no more frames: its failure is returned in `Ok(Some(..))`,
+/// so that the caller can still write the frames it has; `Err` is the callback's own.
 pub fn run_frames(
     world: &mut World,
     plan: &RunPlan,
     fps: Real,
     progress: &mut Progress,
     mut frame: impl FnMut(&World, u64) -> Result<(), Failure>,
-) -> Result<u64, Failure> {
+) -> Result<Option<Failure>, Failure> {
     let frames = frame_count(plan, fps);
     frame(world, 0)?;
     let mut next = 1;
     for k in 1..=plan.steps {
         let h = plan.step_dt(k);
-        world
-            .step(h)
-            .map_err(|e| Failure::Runtime(format!("step {k}: {e}")))?;
+        if let Err(e) = world.step(h) {
+            return Ok(Some(step_failure(k, e)));
+        }
         let t = plan.time_after(k);
         while next < frames && t + 0.5 * h >= next as Real / fps {
             frame(world, next)?;
@@ -40,5 +42,10 @@ pub fn run_frames(
         frame(world, next)?;
         next += 1;
     }
-    Ok(frames)
+    Ok(None)
+}
+
+/// The line a failed step `k` ends a run with (exit 1).
+pub fn step_failure(k: u64, e: tumble::Error) -> Failure {
+    Failure::Runtime(format!("step {k}: {e}"))
 }

@@ -11,9 +11,10 @@ use serde_json::{json, Value};
 use tumble::{BodyKind, Real, World};
 use tumble_render::mesh::Geometry;
 use tumble_render::{Camera, Model, Rgb, Snapshot, BACKGROUND};
-use tumble_scene::{printable, RunPlan, Scene, SceneError};
+use tumble_scene::{RunPlan, Scene, SceneError};
 
 use crate::args::{number, whole};
+use crate::output::{check_distinct, inputs, scene_file, Target, Writer};
 use crate::progress::Progress;
 use crate::sample::{frame_count, run_frames};
 use crate::Failure;
@@ -58,7 +59,7 @@ pub struct ExportArgs {
     #[command(flatten)]
     pub page: PageArgs,
 
-    /// The HTML file to write.
+    /// The HTML file to write (as FILE.html.partial, renamed when complete).
     #[arg(long, value_name = "FILE.html")]
     pub out: PathBuf,
 }
@@ -88,31 +89,40 @@ pub struct ViewArgs {
     pub requests: Option<u64>,
 }
 
-/// `tumble export-html`.
+/// `tumble export-html`. The path is checked, and its partial file created, before the
+/// run; a step that fails ends the run, and the page plays it up to the last good frame
+/// (exit 1).
 pub fn export(args: &ExportArgs) -> Result<(), Failure> {
-    let html = page(&args.page)?;
-    let out = printable(&args.out.display().to_string());
-    std::fs::write(&args.out, html.as_bytes())
-        .map_err(|e| Failure::Input(format!("out: cannot write '{out}': {e}")))?;
+    let target = Target::file("out", &args.out)?;
+    check_distinct(&[&target], &inputs(&scene_file(&args.page.scene)))?;
+    let mut out = Writer::create(target)?;
+    let (html, stopped) = page(&args.page)?;
+    out.write(format_args!("{html}"))?;
+    let shown = out.target().shown().to_string();
+    out.finish()?;
     if !args.page.quiet {
         writeln!(
             std::io::stdout(),
-            "wrote '{out}' ({} kB, opens offline in any browser)",
+            "wrote '{shown}' ({} kB, opens offline in any browser)",
             html.len() / 1024
         )
         .map_err(crate::stdout_failure)?;
     }
-    Ok(())
+    stopped.map_or(Ok(()), Err)
 }
 
-/// `tumble view`: serves the page on localhost and opens it.
+/// `tumble view`: serves the page on localhost and opens it. A run that failed part way is
+/// served up to its last good frame, its account printed first and the exit status 1.
 pub fn view(args: &ViewArgs) -> Result<(), Failure> {
-    let html = page(&args.page)?;
+    let (html, stopped) = page(&args.page)?;
     let listener = TcpListener::bind(("127.0.0.1", args.port))
         .map_err(|e| Failure::Input(format!("port: cannot listen on {}: {e}", args.port)))?;
     let address = listener
         .local_addr()
-        .map_err(|e| Failure::Runtime(format!("port: {e}")))?;
+        .map_err(|e| Failure::Input(format!("port: {e}")))?;
+    if let Some(Failure::Runtime(line)) = &stopped {
+        let _ = writeln!(std::io::stderr(), "{line}");
+    }
     let url = format!("http://{address}/");
     let mut out = std::io::stdout();
     writeln!(out, "serving {url} (Ctrl-C to stop)").map_err(crate::stdout_failure)?;
@@ -129,7 +139,8 @@ pub fn view(args: &ViewArgs) -> Result<(), Failure> {
             break;
         }
     }
-    Ok(())
+    // The account was printed before serving; only the exit status is left to give.
+    stopped.map_or(Ok(()), |_| Err(Failure::Reported(1)))
 }
 
 fn respond(mut stream: TcpStream, html: &str) -> std::io::Result<()> {
@@ -179,7 +190,8 @@ fn open_browser(url: &str) {
 }
 
 /// The whole page for the options: run the scene, record it, wrap it with the viewer.
-pub fn page(args: &PageArgs) -> Result<String, Failure> {
+/// The failure of a step, if one ended the run early, comes second.
+pub fn page(args: &PageArgs) -> Result<(String, Option<Failure>), Failure> {
     let mut scene = tumble_scene::load(&args.scene)?;
     if !(args.fps > 0.0 && args.fps <= 1000.0) {
         return Err(SceneError::new("fps", "must be > 0 and <= 1000").into());
@@ -193,15 +205,16 @@ pub fn page(args: &PageArgs) -> Result<String, Failure> {
         )
         .into());
     }
-    let data = record(&mut scene, &plan, args)?;
+    let (data, stopped) = record(&mut scene, &plan, args)?;
     // Inside <script>, "</" could end the element early; "<\/" means the same in JSON.
     let json = data.to_string().replace("</", "<\\/");
     let title = scene.name.as_deref().unwrap_or(&args.scene);
     let title = title.replace('&', "&amp;").replace('<', "&lt;");
-    Ok(PAGE
+    let html = PAGE
         .replace("{{TITLE}}", &title)
         .replace("{{VIEWER}}", VIEWER_JS)
-        .replace("{{DATA}}", &json))
+        .replace("{{DATA}}", &json);
+    Ok((html, stopped))
 }
 
 /// Rounds for the page: 6 significant digits is more than a screen shows.
@@ -220,7 +233,11 @@ fn v3(out: &mut Vec<Value>, v: tumble::Vec3) {
 }
 
 /// The run as the viewer reads it (viewer/src/main.js).
-fn record(scene: &mut Scene, plan: &RunPlan, args: &PageArgs) -> Result<Value, Failure> {
+fn record(
+    scene: &mut Scene,
+    plan: &RunPlan,
+    args: &PageArgs,
+) -> Result<(Value, Option<Failure>), Failure> {
     let colours: Vec<Option<Rgb>> = scene.body_colors.iter().map(|c| c.map(Rgb)).collect();
     let model = Model::new(&scene.world, &colours, f32::INFINITY);
     let mut times = Vec::new();
@@ -230,7 +247,7 @@ fn record(scene: &mut Scene, plan: &RunPlan, args: &PageArgs) -> Result<Value, F
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut snapshots = Vec::new();
     let mut progress = Progress::new(plan.steps, "recording", args.quiet);
-    run_frames(
+    let stopped = run_frames(
         &mut scene.world,
         plan,
         args.fps,
@@ -270,7 +287,40 @@ fn record(scene: &mut Scene, plan: &RunPlan, args: &PageArgs) -> Result<Value, F
         .bounds(&snapshots)
         .unwrap_or((glam::Vec3::splat(-1.0), glam::Vec3::splat(1.0)));
     let camera = Camera::framing(min, max, 16, 10);
-    let bodies: Vec<Value> = scene
+    let bodies = bodies(scene, &model);
+    let data = json!({
+        "name": scene.name.clone().unwrap_or_else(|| args.scene.clone()),
+        "description": scene.description.clone().unwrap_or_default(),
+        "fps": args.fps,
+        "background": BACKGROUND.hex(),
+        "scale": (max - min).length().max(0.5),
+        "camera": {
+            "eye": camera.eye.to_array(),
+            "target": camera.target.to_array(),
+            "fov_degrees": tumble_render::camera::FOV_Y.to_degrees(),
+        },
+        "bodies": bodies,
+        "times": times,
+        "frames": {
+            "position": position,
+            "orientation": orientation,
+            "velocity": velocity,
+            "omega": omega,
+            "angular_momentum": momentum,
+        },
+        "energy": {
+            "kinetic": kinetic,
+            "potential": potential,
+            "total": total,
+            "angular_momentum": l_norm,
+        },
+    });
+    Ok((data, stopped))
+}
+
+/// Each body's name, kind, colour and shape (a plane, or its triangles) for the viewer.
+fn bodies(scene: &Scene, model: &Model) -> Vec<Value> {
+    scene
         .world
         .bodies()
         .zip(&model.bodies)
@@ -298,32 +348,5 @@ fn record(scene: &mut Scene, plan: &RunPlan, args: &PageArgs) -> Result<Value, F
             }
             b
         })
-        .collect();
-    Ok(json!({
-        "name": scene.name.clone().unwrap_or_else(|| args.scene.clone()),
-        "description": scene.description.clone().unwrap_or_default(),
-        "fps": args.fps,
-        "background": BACKGROUND.hex(),
-        "scale": (max - min).length().max(0.5),
-        "camera": {
-            "eye": camera.eye.to_array(),
-            "target": camera.target.to_array(),
-            "fov_degrees": tumble_render::camera::FOV_Y.to_degrees(),
-        },
-        "bodies": bodies,
-        "times": times,
-        "frames": {
-            "position": position,
-            "orientation": orientation,
-            "velocity": velocity,
-            "omega": omega,
-            "angular_momentum": momentum,
-        },
-        "energy": {
-            "kinetic": kinetic,
-            "potential": potential,
-            "total": total,
-            "angular_momentum": l_norm,
-        },
-    }))
+        .collect()
 }

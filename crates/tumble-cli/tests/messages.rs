@@ -106,4 +106,5 @@ fn help_and_version_are_unchanged() {
     assert_eq!(version, format!("tumble {}\n", env!("CARGO_PKG_VERSION")));
     let help = ok(&["--help"]);
     assert!(help.contains("Exit status: 0 on success"), "{help}");
+    assert!(help.contains(".partial"), "{help}");
 }

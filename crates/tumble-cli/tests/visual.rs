@@ -188,7 +188,7 @@ fn render_refuses_bad_options_in_one_line() {
     );
     assert!(
         refused(&["render", "free_fall", "--out", "/nonexistent/dir/a.gif"])
-            .starts_with("out: cannot write")
+            .starts_with("out: cannot create")
     );
     let bad = dir.join("bad.json");
     std::fs::write(
@@ -371,7 +371,7 @@ fn export_html_writes_one_offline_page_with_the_run() {
     .starts_with("fps: "));
     assert!(
         refused(&["export-html", "free_fall", "--out", "/nonexistent/x.html"])
-            .starts_with("out: cannot write")
+            .starts_with("out: cannot create")
     );
 }
 

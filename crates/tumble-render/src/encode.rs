@@ -40,6 +40,17 @@ impl Output {
         }
     }
 
+    /// The same kind of output, written at `path` instead (a temporary name, say).
+    pub fn at(&self, path: &Path) -> Output {
+        let path = path.to_path_buf();
+        match self {
+            Output::Png(_) => Output::Png(path),
+            Output::Gif(_) => Output::Gif(path),
+            Output::Mp4(_) => Output::Mp4(path),
+            Output::Frames(_) => Output::Frames(path),
+        }
+    }
+
     /// Whether only the last frame is kept.
     pub fn single_frame(&self) -> bool {
         matches!(self, Output::Png(_))
@@ -91,6 +102,8 @@ impl Encoder {
                     .args(["-s", &format!("{width}x{height}"), "-r", &format!("{fps}")])
                     .args(["-i", "-", "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2"])
                     .args(["-pix_fmt", "yuv420p", "-movflags", "+faststart"])
+                    // Said, not guessed from the name, which may be a temporary one.
+                    .args(["-f", "mp4"])
                     .arg(p)
                     .stdin(Stdio::piped())
                     .spawn()
@@ -110,7 +123,7 @@ impl Encoder {
         match self {
             Encoder::Png(p) => write_png(p, pixmap),
             Encoder::Frames(dir, n) => {
-                let path = dir.join(format!("frame_{n:05}.png"));
+                let path = dir.join(frame_name(*n));
                 *n += 1;
                 write_png(&path, pixmap)
             }
@@ -145,6 +158,11 @@ impl Encoder {
             Encoder::Png(_) | Encoder::Frames(..) => Ok(()),
         }
     }
+}
+
+/// The file name of frame `k` in a folder of frames: `frame_00000.png`, ...
+pub fn frame_name(k: usize) -> String {
+    format!("frame_{k:05}.png")
 }
 
 fn dim(x: u32) -> io::Result<u16> {
