@@ -299,6 +299,7 @@ impl PyWorld {
             length_unit: real(length_unit),
             solver: settings.to_core()?,
             sleep,
+            limits: None,
         };
         let world = World::try_new(&def).map_err(engine)?;
         Ok(PyWorld::new_inner(Inner {

@@ -25,7 +25,7 @@ use std::fmt;
 use std::path::Path;
 
 use serde_json::Value;
-use tumble::{Integrator, Real, SolverKind, SolverSettings, Vec3, World, WorldDef};
+use tumble::{Integrator, Real, SolverKind, SolverSettings, SpeedLimits, Vec3, World, WorldDef};
 
 pub use body::BODY_KINDS;
 pub use builtin::{builtin, builtin_names};
@@ -38,7 +38,7 @@ pub use shape::SHAPE_TYPES;
 
 use reader::{Node, Obj};
 
-const TOP_KEYS: [&str; 18] = [
+const TOP_KEYS: [&str; 20] = [
     "name",
     "description",
     "gravity",
@@ -57,6 +57,8 @@ const TOP_KEYS: [&str; 18] = [
     "joint_damping_ratio",
     "length_unit",
     "sleep",
+    "max_speed",
+    "max_angular_speed",
 ];
 
 /// The most `substeps` and `iterations` a scene or the command line may ask for.
@@ -166,12 +168,14 @@ fn build(root: &Node<'_>) -> Result<Scene> {
     obj.only(&TOP_KEYS)?;
     let name = obj.str("name")?.map(str::to_string);
     let description = obj.str("description")?.map(str::to_string);
+    let length_unit = obj.real("length_unit")?.unwrap_or(1.0);
     let def = WorldDef {
         gravity: obj.vec3("gravity")?.unwrap_or(Vec3::new(0.0, -9.8, 0.0)),
         integrator: integrator(&obj)?,
-        length_unit: obj.real("length_unit")?.unwrap_or(1.0),
+        length_unit,
         solver: solver_settings(&obj)?,
         sleep: obj.bool("sleep")?.unwrap_or(true),
+        limits: speed_limits(&obj, length_unit)?,
     };
     let dt = obj.real("dt")?.unwrap_or(DEFAULT_DT);
     let duration = obj.real("duration")?.unwrap_or(DEFAULT_DURATION);
@@ -190,6 +194,25 @@ fn build(root: &Node<'_>) -> Result<Scene> {
         body_names,
         body_colors,
     })
+}
+
+/// `max_speed` and `max_angular_speed`, each defaulting to the engine's value for the
+/// scene's length unit; `None` when neither is given.
+fn speed_limits(obj: &Obj<'_>, length_unit: Real) -> Result<Option<SpeedLimits>> {
+    let (v, w) = (obj.real("max_speed")?, obj.real("max_angular_speed")?);
+    if v.is_none() && w.is_none() {
+        return Ok(None);
+    }
+    let unit = if length_unit.is_finite() && length_unit > 0.0 {
+        length_unit
+    } else {
+        1.0
+    };
+    let default = SpeedLimits::for_length_unit(unit);
+    Ok(Some(SpeedLimits {
+        max_speed: v.unwrap_or(default.max_speed),
+        max_angular_speed: w.unwrap_or(default.max_angular_speed),
+    }))
 }
 
 /// The solver called `name`, with the scene format's error for any other name.

@@ -107,6 +107,16 @@ pub(crate) fn check_settings(duration: Real, dt: Real) -> Result<()> {
     if duration < 0.0 {
         return Err(SceneError::new("duration", "must be >= 0"));
     }
+    at_most_engine_magnitude("duration", duration)
+}
+
+/// The engine's bound on any coefficient (`tumble::limits::MAX_MAGNITUDE`), in seconds.
+fn at_most_engine_magnitude(field: &str, x: Real) -> Result<()> {
+    let most = tumble::limits::MAX_MAGNITUDE;
+    if x > most {
+        let most = tumble::limits::short(most);
+        return Err(SceneError::new(field, format!("must be at most {most} s")));
+    }
     Ok(())
 }
 
@@ -117,7 +127,7 @@ fn check_dt(dt: Real) -> Result<()> {
     if dt <= 0.0 {
         return Err(SceneError::new("dt", "must be > 0"));
     }
-    Ok(())
+    at_most_engine_magnitude("dt", dt)
 }
 
 #[cfg(test)]

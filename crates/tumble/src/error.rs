@@ -25,6 +25,45 @@ pub enum Error {
         /// The id.
         id: BodyId,
     },
+    /// A step's result broke the finite-state invariant (a quantity not finite, or a speed
+    /// beyond the world's limits); the step was undone, the world is as before it.
+    #[error("{}", unstable_message(.0))]
+    Unstable(Box<Unstable>),
+}
+
+/// Where and when a step failed: the step number (the first step is 1), its start time,
+/// the body by creation index, id and name, and what went wrong with which quantity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Unstable {
+    /// The number of the failed step (the world had taken `step - 1`).
+    pub step: u64,
+    /// Simulated time the failed step would have reached (s).
+    pub time: crate::math::Real,
+    /// The body's index in creation order (`bodies[i]` of its scene).
+    pub index: usize,
+    /// The body's handle.
+    pub body: BodyId,
+    /// The body's name, if it has one.
+    pub name: Option<String>,
+    /// `position`, `orientation`, `velocity`, `angular_velocity` or `angular_momentum`.
+    pub quantity: &'static str,
+    /// `is not finite`, or the speed reached and the limit.
+    pub problem: String,
+}
+
+fn unstable_message(u: &Unstable) -> String {
+    let name = match &u.name {
+        Some(n) => format!(" {n:?}"),
+        None => String::new(),
+    };
+    format!(
+        "step {} (t = {} s): bodies[{}]{name}: {} {}",
+        u.step,
+        crate::limits::short(u.time),
+        u.index,
+        u.quantity,
+        u.problem
+    )
 }
 
 impl Error {
@@ -57,6 +96,7 @@ impl Error {
                 field: join(field),
                 id,
             },
+            unstable @ Error::Unstable(_) => unstable,
         }
     }
 
@@ -64,6 +104,7 @@ impl Error {
     pub fn field(&self) -> &str {
         match self {
             Error::InvalidField { field, .. } | Error::UnknownBody { field, .. } => field,
+            Error::Unstable(_) => "",
         }
     }
 }
@@ -71,13 +112,18 @@ impl Error {
 /// Small helpers that turn a failed check into an [`Error::InvalidField`].
 pub(crate) mod check {
     use super::{Error, Result};
+    use crate::limits::MAX_MAGNITUDE;
     use crate::math::{vec3_is_finite, Quat, Real, Vec3};
 
+    /// Finite, and within `limits::MAX_MAGNITUDE`: no coefficient a step multiplies by
+    /// another may overflow (see `limits.rs`).
     pub fn finite(field: &str, x: Real) -> Result<()> {
-        if x.is_finite() {
-            Ok(())
-        } else {
+        if !x.is_finite() {
             Err(Error::invalid(field, "must be a finite number"))
+        } else if x.abs() > MAX_MAGNITUDE {
+            Err(Error::invalid(field, beyond(MAX_MAGNITUDE, "")))
+        } else {
+            Ok(())
         }
     }
 
@@ -99,11 +145,68 @@ pub(crate) mod check {
         }
     }
 
-    pub fn vec3(field: &str, v: Vec3) -> Result<()> {
-        if vec3_is_finite(v) {
+    /// Finite and at most `limit` in magnitude (`unit` follows the limit in the message).
+    pub fn at_most(field: &str, x: Real, limit: Real, unit: &str) -> Result<()> {
+        finite(field, x)?;
+        if x.abs() <= limit {
             Ok(())
         } else {
+            Err(Error::invalid(field, beyond(limit, unit)))
+        }
+    }
+
+    /// Finite, every component at most `limit` in magnitude.
+    pub fn vec3_at_most(field: &str, v: Vec3, limit: Real, unit: &str) -> Result<()> {
+        if !vec3_is_finite(v) {
+            return Err(Error::invalid(field, "must be finite numbers"));
+        }
+        if v.abs().max_element() <= limit {
+            Ok(())
+        } else {
+            Err(Error::invalid(field, beyond(limit, unit)))
+        }
+    }
+
+    /// Finite, and a vector no longer than `limit`.
+    pub fn length_at_most(field: &str, v: Vec3, limit: Real, unit: &str) -> Result<()> {
+        vec3(field, v)?;
+        // Scaled first, so that components near the largest float do not overflow.
+        let scale = v.abs().max_element();
+        if scale <= limit && (scale == 0.0 || (v / scale).length() * scale <= limit) {
+            Ok(())
+        } else {
+            let unit = if unit.is_empty() {
+                String::new()
+            } else {
+                format!(" {unit}")
+            };
+            let reason = format!(
+                "must be no longer than {}{unit}",
+                crate::limits::short(limit)
+            );
+            Err(Error::invalid(field, reason))
+        }
+    }
+
+    fn beyond(limit: Real, unit: &str) -> String {
+        let unit = if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {unit}")
+        };
+        format!(
+            "must be at most {}{unit} in magnitude",
+            crate::limits::short(limit)
+        )
+    }
+
+    pub fn vec3(field: &str, v: Vec3) -> Result<()> {
+        if !vec3_is_finite(v) {
             Err(Error::invalid(field, "must be finite numbers"))
+        } else if v.abs().max_element() > MAX_MAGNITUDE {
+            Err(Error::invalid(field, beyond(MAX_MAGNITUDE, "")))
+        } else {
+            Ok(())
         }
     }
 
@@ -121,6 +224,13 @@ pub(crate) mod check {
         let parts = [q.x, q.y, q.z, q.w];
         if parts.iter().any(|c| !c.is_finite()) {
             return Err(Error::invalid(field, "must be finite numbers"));
+        }
+        // Huge ones are scaled by their largest component first: [1e308, 0, 0, 1] is a
+        // rotation too, and its squared length would overflow.
+        let scale = parts.iter().fold(0.0 as Real, |m, c| m.max(c.abs()));
+        if scale > 1e15 {
+            let q = q / scale;
+            return Ok(q / q.length());
         }
         let n = q.length();
         if n < 1e-6 {

@@ -19,6 +19,7 @@ pub mod dynamics;
 pub mod error;
 pub(crate) mod handles;
 pub mod id;
+pub mod limits;
 pub mod math;
 pub mod pipeline;
 
@@ -39,6 +40,7 @@ pub use geometry::{Aabb, Pose, Ray, RayHit};
 pub use id::{BodyId, ForceId};
 pub use integrate::Integrator;
 pub use joint::{Joint, JointDef, JointId, JointKind, JointSpring, Motor};
+pub use limits::SpeedLimits;
 pub use math::{Mat3, Quat, Real, Vec3};
 pub use narrow_phase::{ContactPoint, Manifold};
 pub use shape::Convex;

@@ -365,13 +365,15 @@ impl Body {
 }
 
 fn validate_def(def: &BodyDef) -> Result<()> {
-    check::vec3("position", def.position)?;
+    use crate::limits::MAX_COORDINATE;
+    check::vec3_at_most("position", def.position, MAX_COORDINATE, "m")?;
     check::vec3("velocity", def.linear_velocity)?;
     check::vec3("angular_velocity", def.angular_velocity)?;
     if let Some(c) = def.center_of_mass {
-        check::vec3("center_of_mass", c)?;
+        check::vec3_at_most("center_of_mass", c, MAX_COORDINATE, "m")?;
     }
     check::non_negative("friction", def.friction)?;
+    check::at_most("friction", def.friction, crate::limits::MAX_MAGNITUDE, "")?;
     check::non_negative("restitution", def.restitution)?;
     if def.restitution > 1.0 {
         return Err(Error::invalid("restitution", "must be <= 1"));
@@ -416,12 +418,24 @@ fn mass_properties(def: &BodyDef, shape: &Shape) -> Result<MassProperties> {
 }
 
 /// Valid sizes can still multiply out to nothing or to infinity (a 1e-120 m sphere has no
-/// volume in floating point, 1e308 kg/m³ times a litre overflows); such a body would
-/// turn NaN on its first step. The error names the factor that is out of range.
+/// volume in floating point, 1e308 kg/m³ times a litre overflows), or to a mass whose
+/// inverse overflows a step (a density of 1e-300); such a body would turn NaN on its
+/// first step. The mass must lie in `limits`' [`MIN_MASS`, `MAX_MASS`], each principal
+/// moment in [`MIN_MOMENT`, `MAX_MOMENT`]; the error names the factor out of range.
 fn check_mass_came_out(def: &BodyDef, shape: &Shape, props: &MassProperties) -> Result<()> {
-    let good = |x: Real| x.is_finite() && x > 0.0;
+    use crate::limits::{short, MAX_MASS, MAX_MOMENT, MIN_MASS, MIN_MOMENT};
     let (moments, _) = crate::math::symmetric_eigen(props.inertia);
-    if good(props.mass) && good(moments.x) && good(moments.y) && good(moments.z) {
+    let good = |x: Real| x.is_finite() && x > 0.0;
+    // Only a dynamic body's mass enters a step: a static ground may weigh what it likes.
+    let (mass_ok, moment_ok): (&dyn Fn(Real) -> bool, &dyn Fn(Real) -> bool) =
+        if def.kind == BodyKind::Dynamic {
+            (&|m| (MIN_MASS..=MAX_MASS).contains(&m), &|x| {
+                (MIN_MOMENT..=MAX_MOMENT).contains(&x)
+            })
+        } else {
+            (&good, &good)
+        };
+    if mass_ok(props.mass) && moments.to_array().into_iter().all(moment_ok) {
         return Ok(());
     }
     let unit = shape.mass_properties(1.0);
@@ -440,8 +454,15 @@ fn check_mass_came_out(def: &BodyDef, shape: &Shape, props: &MassProperties) -> 
     Err(Error::invalid(
         field,
         format!(
-            "mass and inertia come out zero or infinite at this size ({} kg, principal moments [{}, {}, {}] kg·m²)",
-            props.mass, moments.x, moments.y, moments.z
+            "mass and inertia come out at {} kg, principal moments [{}, {}, {}] kg·m²: the mass must be in [{}, {}] kg, each moment in [{}, {}] kg·m²",
+            short(props.mass),
+            short(moments.x),
+            short(moments.y),
+            short(moments.z),
+            short(MIN_MASS),
+            short(MAX_MASS),
+            short(MIN_MOMENT),
+            short(MAX_MOMENT)
         ),
     ))
 }

@@ -8,6 +8,7 @@ use crate::dynamics::body::Motion;
 use crate::dynamics::body::{Body, BodyKind};
 use crate::error::{check, Result};
 use crate::id::BodyId;
+use crate::limits::MAX_COORDINATE;
 use crate::math::{Real, Vec3};
 
 /// Force and torque on one body (world frame, torque about the centre of mass).
@@ -91,10 +92,14 @@ impl Force {
     pub(crate) fn validate(&self) -> Result<()> {
         match self {
             Force::Spring(s) => {
-                check::vec3("anchor", s.anchor)?;
+                check::vec3_at_most("anchor", s.anchor, MAX_COORDINATE, "m")?;
                 match s.other {
-                    SpringEnd::World(p) => check::vec3("world_point", p)?,
-                    SpringEnd::Body { anchor, .. } => check::vec3("other_anchor", anchor)?,
+                    SpringEnd::World(p) => {
+                        check::vec3_at_most("world_point", p, MAX_COORDINATE, "m")?
+                    }
+                    SpringEnd::Body { anchor, .. } => {
+                        check::vec3_at_most("other_anchor", anchor, MAX_COORDINATE, "m")?
+                    }
                 }
                 check::non_negative("stiffness", s.stiffness)?;
                 check::non_negative("rest_length", s.rest_length)?;
@@ -107,7 +112,7 @@ impl Force {
             Force::Applied(a) => {
                 check::vec3("force", a.force)?;
                 if let Some(p) = a.point {
-                    check::vec3("point", p)?;
+                    check::vec3_at_most("point", p, MAX_COORDINATE, "m")?;
                 }
                 check::vec3("torque", a.torque)
             }

@@ -39,6 +39,8 @@ pub(crate) struct ContactCache {
     /// Scratch for sorting `keys` with their indices.
     keyed: Vec<(Key, u32)>,
     events: Vec<ContactEvent>,
+    /// The events of the update before, kept so that a failed step can be undone.
+    events_before: Vec<ContactEvent>,
     pairs: Vec<(u32, u32)>,
     manifolds: Vec<Manifold>,
     /// The touching body pairs of `contacts` and of `previous`, sorted: last update's
@@ -271,6 +273,7 @@ impl ContactCache {
         self.touching.sort();
         self.touching.dedup();
         let (now, before) = (&self.touching, &self.touching_before);
+        std::mem::swap(&mut self.events, &mut self.events_before);
         self.events.clear();
         // Both lists are sorted: one merge-like walk per direction finds what is missing
         // from the other, where a binary search per pair was a third of the update's time.
@@ -278,6 +281,16 @@ impl ContactCache {
             .extend(missing(now, before, ContactEventKind::Begin));
         self.events
             .extend(missing(before, now, ContactEventKind::End));
+    }
+
+    /// Returns the cache to its state before the last [`ContactCache::update`]: the update
+    /// read last step's contacts, touching pairs and events and built new ones beside
+    /// them, so three swaps undo it (what the swaps bring back in place of the old lists
+    /// is scratch the next update overwrites).
+    pub(crate) fn undo_update(&mut self) {
+        std::mem::swap(&mut self.contacts, &mut self.previous);
+        std::mem::swap(&mut self.touching, &mut self.touching_before);
+        std::mem::swap(&mut self.events, &mut self.events_before);
     }
 
     /// The contacts, for the solver to store impulses in.

@@ -22,6 +22,7 @@
 use crate::error::{check, Error, Result};
 use crate::id::BodyId;
 pub use crate::id::JointId;
+use crate::limits::MAX_COORDINATE;
 
 mod kinds;
 use crate::math::{orthonormal_basis, Quat, Real, Vec3};
@@ -223,8 +224,8 @@ impl Joint {
 
 /// Checks a definition's numbers; field paths are relative to the def (`limits`, `axis`).
 pub(crate) fn validate(def: &JointDef) -> Result<()> {
-    check::vec3("anchor", def.anchor)?;
-    check::vec3("other_anchor", def.other_anchor)?;
+    check::vec3_at_most("anchor", def.anchor, MAX_COORDINATE, "m")?;
+    check::vec3_at_most("other_anchor", def.other_anchor, MAX_COORDINATE, "m")?;
     for (field, axis) in [("axis", def.axis), ("other_axis", def.other_axis)] {
         check::vec3(field, axis)?;
         if axis.length() < 1e-9 {
@@ -280,8 +281,16 @@ fn check_range(field: &str, [lo, hi]: [Real; 2]) -> Result<()> {
 }
 
 fn check_spring(field: &str, s: &JointSpring) -> Result<()> {
-    check::positive(&format!("{field}.hertz"), s.hertz)?;
-    check::non_negative(&format!("{field}.damping_ratio"), s.damping_ratio)?;
+    let (hertz, ratio) = (format!("{field}.hertz"), format!("{field}.damping_ratio"));
+    check::positive(&hertz, s.hertz)?;
+    check::at_most(&hertz, s.hertz, crate::limits::MAX_HERTZ, "Hz")?;
+    check::non_negative(&ratio, s.damping_ratio)?;
+    check::at_most(
+        &ratio,
+        s.damping_ratio,
+        crate::limits::MAX_DAMPING_RATIO,
+        "",
+    )?;
     check::finite(&format!("{field}.target"), s.target)
 }
 

@@ -7,8 +7,9 @@ use crate::collision::shape::Shape;
 use crate::dynamics::body::{Body, BodyDef, BodyKind};
 use crate::error::{check, Error, Result};
 use crate::id::BodyId;
+use crate::limits::{MAX_COORDINATE, MAX_MAGNITUDE};
 use crate::math::{Quat, Vec3};
-use crate::pipeline::world::World;
+use crate::pipeline::world::{check_speeds, World};
 
 impl World {
     /// Creates a body; fails (changing nothing) if the definition or shape is invalid or
@@ -23,6 +24,7 @@ impl World {
             }
         }
         let body = Body::new(def, shape)?;
+        check_speeds(&self.settings.limits, body.velocity, body.angular_velocity)?;
         let store = &mut self.bodies;
         let id = store.handles.insert();
         let kind = if body.kind == BodyKind::Static {
@@ -173,7 +175,7 @@ impl World {
 
     /// Moves a body so its frame's origin is at `position` (m); velocities are kept.
     pub fn set_position(&mut self, id: BodyId, position: Vec3) -> Result<()> {
-        check::vec3("position", position)?;
+        check::vec3_at_most("position", position, MAX_COORDINATE, "m")?;
         self.edit_body(id, |b| b.com = position + b.orientation * b.local_center)
     }
 
@@ -189,7 +191,7 @@ impl World {
 
     /// Sets the velocity of the centre of mass (m/s).
     pub fn set_linear_velocity(&mut self, id: BodyId, velocity: Vec3) -> Result<()> {
-        check::vec3("velocity", velocity)?;
+        check_speeds(&self.settings.limits, velocity, Vec3::ZERO)?;
         self.edit_body(id, |b| {
             if b.kind != BodyKind::Static {
                 b.velocity = velocity;
@@ -199,7 +201,7 @@ impl World {
 
     /// Sets the angular velocity (rad/s, world frame); L follows as I_world ω.
     pub fn set_angular_velocity(&mut self, id: BodyId, omega: Vec3) -> Result<()> {
-        check::vec3("angular_velocity", omega)?;
+        check_speeds(&self.settings.limits, Vec3::ZERO, omega)?;
         let i = self.dense_or_err(id)?;
         self.bodies.list[i].set_angular_velocity_internal(omega);
         self.memory.forget(i);
@@ -209,21 +211,28 @@ impl World {
 
     /// Applies an impulse J (N·s) at a world point: Δp = J, ΔL = (point − x) × J.
     pub fn apply_impulse(&mut self, id: BodyId, impulse: Vec3, world_point: Vec3) -> Result<()> {
-        check::vec3("impulse", impulse)?;
-        check::vec3("point", world_point)?;
+        check::vec3_at_most("impulse", impulse, MAX_MAGNITUDE, "N·s")?;
+        check::vec3_at_most("point", world_point, MAX_COORDINATE, "m")?;
         let i = self.dense_or_err(id)?;
-        let b = &mut self.bodies.list[i];
+        let b = &self.bodies.list[i];
         if b.kind != BodyKind::Dynamic {
             return Ok(());
         }
-        b.velocity += impulse * b.inv_mass;
+        // Worked out in full and checked before anything changes: an impulse that would
+        // take the body past the speed limits is refused, the body left as it was.
+        let mut v = b.velocity + impulse * b.inv_mass;
         let mut l = b.angular_momentum + (world_point - b.com).cross(impulse);
         if b.planar {
-            b.velocity.z = 0.0;
+            v.z = 0.0;
             l = Vec3::new(0.0, 0.0, l.z);
         }
+        let w = b.omega_from_momentum(b.orientation, l);
+        check_speeds(&self.settings.limits, v, w)
+            .map_err(|e| Error::invalid("impulse", format!("would make the body's {e}")))?;
+        let b = &mut self.bodies.list[i];
+        b.velocity = v;
         b.angular_momentum = l;
-        b.angular_velocity = b.omega_from_momentum(b.orientation, l);
+        b.angular_velocity = w;
         self.memory.forget(i);
         self.wake_around(i);
         Ok(())

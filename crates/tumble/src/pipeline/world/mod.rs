@@ -21,6 +21,7 @@
 
 mod bodies;
 mod forces;
+mod invariant;
 mod joints;
 pub mod query;
 pub(crate) mod step;
@@ -35,10 +36,22 @@ use crate::dynamics::solver::{Scales, SolverSettings};
 use crate::error::{check, Error, Result};
 use crate::handles::Handles;
 use crate::id::{BodyId, ForceId};
+use crate::limits::{SpeedLimits, MAX_ACCELERATION};
 use crate::math::{Real, Vec3};
 use crate::pipeline::contact_cache::ContactCache;
 use crate::pipeline::diagnostics::{self, Diagnostics};
 use step::StepContext;
+
+/// A body's velocities must be within the world's speed limits.
+pub(crate) fn check_speeds(limits: &SpeedLimits, v: Vec3, w: Vec3) -> Result<()> {
+    check::length_at_most("velocity", v, limits.max_speed, "m/s (max_speed)")?;
+    check::length_at_most(
+        "angular_velocity",
+        w,
+        limits.max_angular_speed,
+        "rad/s (max_angular_speed)",
+    )
+}
 
 /// World settings; `Default` is the seed's: g = 9.8 m/s² down the y axis, symplectic Euler.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,6 +69,9 @@ pub struct WorldDef {
     pub solver: SolverSettings,
     /// Whether resting islands may fall asleep (they wake on any disturbance).
     pub sleep: bool,
+    /// The speeds no body may reach (see `limits.rs`); `None` takes the defaults for
+    /// `length_unit`.
+    pub limits: Option<SpeedLimits>,
 }
 
 impl Default for WorldDef {
@@ -66,6 +82,7 @@ impl Default for WorldDef {
             length_unit: 1.0,
             solver: SolverSettings::default(),
             sleep: true,
+            limits: None,
         }
     }
 }
@@ -108,6 +125,7 @@ pub(crate) struct Settings {
     pub tolerances: Tolerances,
     pub solver: SolverSettings,
     pub sleep: bool,
+    pub limits: SpeedLimits,
 }
 
 /// Simulated time (s) and the number of steps taken.
@@ -182,10 +200,13 @@ pub struct World {
 impl World {
     /// An empty world, after checking the definition.
     pub fn try_new(def: &WorldDef) -> Result<World> {
-        check::vec3("gravity", def.gravity)?;
+        check::vec3_at_most("gravity", def.gravity, MAX_ACCELERATION, "m/s²")?;
         check::positive("length_unit", def.length_unit)?;
         let mut world = World::new(def);
         world.set_solver_settings(def.solver)?;
+        if let Some(limits) = def.limits {
+            world.set_speed_limits(limits)?;
+        }
         Ok(world)
     }
 
@@ -205,6 +226,7 @@ impl World {
                 tolerances,
                 solver: def.solver,
                 sleep: def.sleep,
+                limits: def.limits.unwrap_or(SpeedLimits::for_length_unit(unit)),
             },
             clock: Clock::default(),
             bodies: BodyStore::default(),
@@ -241,11 +263,39 @@ impl World {
 
     /// Changes gravity.
     pub fn set_gravity(&mut self, gravity: Vec3) -> Result<()> {
-        check::vec3("gravity", gravity)?;
+        check::vec3_at_most("gravity", gravity, MAX_ACCELERATION, "m/s²")?;
         if gravity != self.settings.gravity {
             self.wake_all();
         }
         self.settings.gravity = gravity;
+        Ok(())
+    }
+
+    /// The speeds no body may reach: every step checks its result against them.
+    pub fn speed_limits(&self) -> SpeedLimits {
+        self.settings.limits
+    }
+
+    /// Changes the speed limits; refused (changing nothing) if they are not positive
+    /// numbers or a body already moves faster.
+    pub fn set_speed_limits(&mut self, limits: SpeedLimits) -> Result<()> {
+        check::positive("max_speed", limits.max_speed)?;
+        check::positive("max_angular_speed", limits.max_angular_speed)?;
+        for (i, b) in self.bodies.list.iter().enumerate() {
+            let (v, w) = (b.velocity.length(), b.angular_velocity.length());
+            let refuse = |field: &str, x: Real, unit: &str| {
+                let x = crate::limits::short(x);
+                let reason = format!("must be at least {x} {unit}: bodies[{i}] moves that fast");
+                Err(Error::invalid(field, reason))
+            };
+            if v > limits.max_speed {
+                return refuse("max_speed", v, "m/s");
+            }
+            if w > limits.max_angular_speed {
+                return refuse("max_angular_speed", w, "rad/s");
+            }
+        }
+        self.settings.limits = limits;
         Ok(())
     }
 
@@ -292,11 +342,22 @@ impl World {
         if settings.iterations == 0 {
             return Err(Error::invalid("iterations", "must be >= 1"));
         }
-        check::positive("contact_hertz", settings.contact_hertz)?;
-        check::non_negative("contact_damping_ratio", settings.contact_damping_ratio)?;
+        use crate::limits::{MAX_DAMPING_RATIO, MAX_HERTZ};
+        for (field, hz) in [
+            ("contact_hertz", settings.contact_hertz),
+            ("joint_hertz", settings.joint_hertz),
+        ] {
+            check::positive(field, hz)?;
+            check::at_most(field, hz, MAX_HERTZ, "Hz")?;
+        }
+        for (field, ratio) in [
+            ("contact_damping_ratio", settings.contact_damping_ratio),
+            ("joint_damping_ratio", settings.joint_damping_ratio),
+        ] {
+            check::non_negative(field, ratio)?;
+            check::at_most(field, ratio, MAX_DAMPING_RATIO, "")?;
+        }
         check::non_negative("baumgarte", settings.baumgarte)?;
-        check::positive("joint_hertz", settings.joint_hertz)?;
-        check::non_negative("joint_damping_ratio", settings.joint_damping_ratio)?;
         self.settings.solver = settings;
         Ok(())
     }

@@ -13,6 +13,9 @@
 //!                                                          contact impulses, joint reactions
 //! move_kinematic       context                             kinematic solver bodies
 //! sweep_fast           bodies, broad phase; context        fast solver bodies (time of impact)
+//! check_result         context                             nothing; on a non-finite or too
+//!                                                          fast body, undoes the step and
+//!                                                          returns the error
 //! scatter              context                             bodies' state, broad-phase proxies
 //! update_sleep         bodies, contacts, joint links       sleep timers, awake flags, tags
 //! ```
@@ -48,6 +51,8 @@ pub(crate) struct StepContext {
     integrate: Scratch,
     /// The solver's constraints and buffers.
     solver: Solver,
+    /// What the stages before the check change, as it was (see `invariant.rs`).
+    pub(super) undo: super::invariant::Undo,
     /// The moved proxies' new tight boxes and displacements, handed to the broad phase
     /// together.
     proxy_updates: Vec<(crate::collision::broad_phase::ProxyId, Aabb, Vec3)>,
@@ -57,10 +62,17 @@ impl World {
     /// Advances the world by `dt` seconds: contacts are found at the current state, bodies
     /// touching nothing advance with the world's integrator alone, bodies in contact or
     /// joined go through the solver's substeps (see `dynamics/solver/mod.rs`).
+    ///
+    /// A step whose result has a non-finite value or a speed beyond the world's limits is
+    /// undone, leaving the world as it was, and returns [`Error::Unstable`] naming the
+    /// step, the body and the quantity (see `invariant.rs`).
+    ///
+    /// [`Error::Unstable`]: crate::error::Error::Unstable
     pub fn step(&mut self, dt: Real) -> Result<()> {
         check::positive("dt", dt)?;
         let time = StepTime::new(self.clock.time, dt, &self.settings.solver);
         self.refresh_joint_links();
+        self.keep_undo();
         self.update_contacts();
         self.wake_touched();
         self.gather();
@@ -69,6 +81,7 @@ impl World {
         self.solve(&time);
         self.move_kinematic(&time);
         self.sweep_fast();
+        self.check_result(&time)?;
         self.scatter();
         self.update_sleep(&time);
         self.clock.time += dt;

@@ -1,0 +1,109 @@
+//! The ranges the engine accepts, and the speeds a step may reach.
+//!
+//! A value can be finite and still be nonsense a step cannot survive: an orientation of
+//! 1e308 overflows when normalised, a density of 1e-300 gives an inverse mass of 1e300, a
+//! spring of 1e300 Hz squares to infinity. Each bound below is far outside what any
+//! physical scene needs and far inside what the arithmetic of a step can carry without
+//! overflow, in f32 too (3.4e38): the largest product a step forms of two bounded values
+//! stays below 1e32. Values beyond them are refused where they enter (scene files, setters,
+//! Python), with the bound in the message.
+//!
+//! The speeds are different: they are the invariant every step checks on its result (see
+//! `pipeline/world/step.rs`). They are settings with generous defaults, since a scene of
+//! bullets or of turbines may need more; a body set faster than them is refused, a body a
+//! step makes faster than them stops the run with the step undone.
+
+use crate::math::Real;
+
+/// Largest accepted |coordinate| of a position (m): 1e9 m, three light-seconds.
+pub const MAX_COORDINATE: Real = 1e9;
+/// Largest accepted |component| of gravity (m/s²): 1e6, a hundred thousand g.
+pub const MAX_ACCELERATION: Real = 1e6;
+/// Accepted body masses (kg): a speck of dust to a mountain.
+pub const MIN_MASS: Real = 1e-12;
+/// See [`MIN_MASS`].
+pub const MAX_MASS: Real = 1e15;
+/// Accepted principal moments of inertia (kg·m²).
+pub const MIN_MOMENT: Real = 1e-30;
+/// See [`MIN_MOMENT`].
+pub const MAX_MOMENT: Real = 1e30;
+/// Largest accepted frequency of a soft constraint or spring (Hz): far beyond any step's
+/// resolution (1/dt), where the soft constraint is already rigid.
+pub const MAX_HERTZ: Real = 1e6;
+/// Largest accepted damping ratio (1 is critical).
+pub const MAX_DAMPING_RATIO: Real = 1e6;
+/// Largest accepted magnitude of any other coefficient: stiffness (N/m), damping (N·s/m),
+/// forces (N), impulses (N·s), torques, drag and motor limits.
+pub const MAX_MAGNITUDE: Real = 1e15;
+
+/// The speeds no body may exceed, checked on every step's result.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpeedLimits {
+    /// Largest speed of a centre of mass (m/s); default 10 km/s, faster than a rifle
+    /// bullet (1 km/s) or an orbit (7.8 km/s), times the scene's `length_unit`.
+    pub max_speed: Real,
+    /// Largest angular speed (rad/s); default 1e5, seven times an ultracentrifuge's.
+    pub max_angular_speed: Real,
+}
+
+impl SpeedLimits {
+    /// The defaults for a scene whose lengths are in `length_unit` metres.
+    pub fn for_length_unit(length_unit: Real) -> SpeedLimits {
+        SpeedLimits {
+            max_speed: 1e4 * length_unit,
+            max_angular_speed: 1e5,
+        }
+    }
+}
+
+impl Default for SpeedLimits {
+    fn default() -> Self {
+        SpeedLimits::for_length_unit(1.0)
+    }
+}
+
+/// A number as people write it: `0.683`, `1e15`, `2.5e-7`, never 300 digits.
+pub fn short(x: Real) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let a = x.abs();
+    if (1e-4..1e6).contains(&a) {
+        // Six significant digits, trailing zeros dropped.
+        let digits = (5 - a.log10().floor() as i32).clamp(0, 10) as usize;
+        let s = format!("{x:.digits$}");
+        let s = if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        };
+        return s;
+    }
+    let s = format!("{x:.5e}");
+    let (mantissa, exponent) = s.split_once('e').unwrap_or((&s, "0"));
+    let mantissa = if mantissa.contains('.') {
+        mantissa.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        mantissa
+    };
+    format!("{mantissa}e{exponent}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::short;
+
+    #[test]
+    fn numbers_in_messages_are_short() {
+        assert_eq!(short(0.683), "0.683");
+        assert_eq!(short(1e15), "1e15");
+        assert_eq!(short(-2.5e-7), "-2.5e-7");
+        assert_eq!(short(3e38), "3e38");
+        assert_eq!(short(41.0), "41");
+        assert_eq!(short(123456.0), "123456");
+        assert_eq!(short(1.0 / 3.0), "0.333333");
+        assert!(short(Real::MAX).len() < 16);
+    }
+
+    use crate::math::Real;
+}
