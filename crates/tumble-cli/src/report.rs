@@ -4,6 +4,7 @@
 
 use std::io::{self, Write};
 
+use tumble::limits::short;
 use tumble::{Diagnostics, Real, World};
 use tumble_scene::{RunPlan, Scene};
 
@@ -16,6 +17,16 @@ fn say(args: std::fmt::Arguments<'_>) -> Result<(), Failure> {
     writeln!(io::stdout(), "{args}").map_err(stdout_failure)
 }
 
+/// `x` with `decimals` digits after the point, as a table shows it; in exponent form when
+/// it is too large for that (`{:.6}` of 1e300 is 307 characters) or not finite.
+fn fixed(x: Real, decimals: usize) -> String {
+    if x.is_finite() && x.abs() < 1e9 {
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.decimals$e}")
+    }
+}
+
 /// The seed's output: the first body's height every 0.1 s against the closed form for
 /// constant gravity, y(t) = y₀ + v₀ t + ½ g t².
 pub struct SeedTable {
@@ -25,6 +36,8 @@ pub struct SeedTable {
     y0: Real,
     vy0: Real,
     gy: Real,
+    /// Standard output was closed: the run goes on for its files, silently.
+    closed: bool,
 }
 
 impl SeedTable {
@@ -34,22 +47,39 @@ impl SeedTable {
             return Err(Failure::Input("scene: the seed table needs a body".into()));
         };
         let stride = (TABLE_INTERVAL / plan.dt).round().max(1.0) as u64;
-        say(format_args!(
-            "free fall ({}, dt = {} s): numerical height against 5 - 1/2 g t^2",
-            world.integrator().name(),
-            plan.dt
-        ))?;
-        say(format_args!(
-            "{:>8}  {:>12}  {:>12}  {:>12}",
-            "time (s)", "height (m)", "analytic (m)", "error (m)"
-        ))?;
-        Ok(SeedTable {
+        let mut table = SeedTable {
             stride,
             last: plan.steps,
             y0: body.position().y,
             vy0: body.linear_velocity().y,
             gy: world.gravity().y,
-        })
+            closed: false,
+        };
+        table.say(format_args!(
+            "free fall ({}, dt = {} s): numerical height against 5 - 1/2 g t^2",
+            world.integrator().name(),
+            short(plan.dt)
+        ))?;
+        table.say(format_args!(
+            "{:>8}  {:>12}  {:>12}  {:>12}",
+            "time (s)", "height (m)", "analytic (m)", "error (m)"
+        ))?;
+        Ok(table)
+    }
+
+    /// A line of the table. Once standard output is closed (`tumble run | head`) the
+    /// table stops, but not the run: its files are still wanted whole.
+    fn say(&mut self, args: std::fmt::Arguments<'_>) -> Result<(), Failure> {
+        if self.closed {
+            return Ok(());
+        }
+        match say(args) {
+            Err(Failure::Closed) => {
+                self.closed = true;
+                Ok(())
+            }
+            other => other,
+        }
     }
 
     fn analytic(&self, t: Real) -> Real {
@@ -66,20 +96,26 @@ impl SeedTable {
             return Ok(());
         }
         let (y, exact) = (Self::height(world), self.analytic(time));
-        say(format_args!(
-            "{time:>8.3}  {y:>12.8}  {exact:>12.8}  {:>12.3e}",
+        self.say(format_args!(
+            "{:>8}  {:>12}  {:>12}  {:>12.3e}",
+            fixed(time, 3),
+            fixed(y, 8),
+            fixed(exact, 8),
             y - exact
         ))
     }
 
     /// The one-line summary.
-    pub fn finish(&self, world: &World, plan: &RunPlan) -> Result<(), Failure> {
+    pub fn finish(mut self, world: &World, plan: &RunPlan) -> Result<(), Failure> {
         let t = plan.end_time;
         let (y, exact) = (Self::height(world), self.analytic(t));
-        say(format_args!(
-            "after {} steps (t = {t} s): height {y:.6} m, analytic {exact:.6} m, error {:.6} m",
+        self.say(format_args!(
+            "after {} steps (t = {} s): height {} m, analytic {} m, error {} m",
             plan.steps,
-            y - exact
+            short(t),
+            fixed(y, 6),
+            fixed(exact, 6),
+            fixed(y - exact, 6)
         ))
     }
 }
@@ -109,15 +145,19 @@ impl Summary {
         ))?;
         say(format_args!(
             "{} steps of dt = {} s, final time {} s",
-            plan.steps, plan.dt, plan.end_time
+            plan.steps,
+            short(plan.dt),
+            short(plan.end_time)
         ))?;
         let width = scene.body_names.iter().map(String::len).max().unwrap_or(0);
         say(format_args!("final positions (m):"))?;
         for ((_, body), label) in world.bodies().zip(&scene.body_names) {
             let p = body.position();
             say(format_args!(
-                "  {label:<width$}  {:>14.6} {:>14.6} {:>14.6}",
-                p.x, p.y, p.z
+                "  {label:<width$}  {:>14} {:>14} {:>14}",
+                fixed(p.x, 6),
+                fixed(p.y, 6),
+                fixed(p.z, 6)
             ))?;
         }
         self.energy(world.diagnostics().total)
@@ -132,7 +172,9 @@ impl Summary {
             String::new()
         };
         say(format_args!(
-            "total energy (J): start {start:.9}, end {end:.9}, change {change:+.3e}{relative}"
+            "total energy (J): start {}, end {}, change {change:+.3e}{relative}",
+            fixed(start, 9),
+            fixed(end, 9)
         ))
     }
 }

@@ -1,5 +1,5 @@
 //! Every refusal of the command line is one line naming the option, exit status 2; help
-//! and version are clap's own, exit status 0.
+//! and version are clap's own, exit status 0; numbers in what is printed stay short.
 
 mod common;
 
@@ -107,4 +107,21 @@ fn help_and_version_are_unchanged() {
     let help = ok(&["--help"]);
     assert!(help.contains("Exit status: 0 on success"), "{help}");
     assert!(help.contains(".partial"), "{help}");
+}
+
+#[test]
+fn numbers_are_printed_short() {
+    // Rust's `{}` writes 1e-300 with 300 zeros and `{:.6}` of 1e30 with 31 digits.
+    for args in [
+        &["run", "free_fall", "--dt", "1e-300", "--steps", "2"][..],
+        &["run", "--dt", "1e-300", "--steps", "2"],
+        &["run", "spring", "--dt", "1e30", "--steps", "1"],
+        &["run", "--dt", "1e30", "--steps", "1"],
+    ] {
+        let out = tumble(args);
+        let text = stdout(&out) + &stderr(&out);
+        for line in text.lines() {
+            assert!(line.len() < 120, "tumble {args:?}: {line}");
+        }
+    }
 }
