@@ -45,7 +45,12 @@ pub fn run_frames(
     Ok(None)
 }
 
-/// The line a failed step `k` ends a run with (exit 1).
+/// The line a failed step `k` ends a run with (exit 1). The engine's account of an unstable
+/// step already names the step, the time, the body and the quantity; any other refusal
+/// gets the step's number in front.
 pub fn step_failure(k: u64, e: tumble::Error) -> Failure {
-    Failure::Runtime(format!("step {k}: {e}"))
+    match e {
+        tumble::Error::Unstable(_) => Failure::Runtime(e.to_string()),
+        other => Failure::Runtime(format!("step {k}: {other}")),
+    }
 }
