@@ -305,3 +305,21 @@ fn frames_replace_a_folders_frames_only_when_complete() {
         .starts_with(b"\x89PNG"));
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn a_closed_standard_output_stops_the_table_not_the_files() {
+    // `tumble run --out traj.csv | head -1`: the seed table meets a closed pipe.
+    let dir = scratch("closed");
+    let out = dir.join("traj.csv");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tumble"))
+        .args(["run", "--out", path(&out)])
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("tumble starts");
+    drop(child.stdout.take());
+    assert!(child.wait().unwrap().success());
+    // The seed's 100 steps, all recorded, and the header.
+    assert_eq!(read(&out).lines().count(), 102);
+    assert_eq!(names(&dir), ["traj.csv"]);
+    std::fs::remove_dir_all(dir).unwrap();
+}
