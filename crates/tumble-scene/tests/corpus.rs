@@ -24,7 +24,7 @@ fn corpus() -> Vec<PathBuf> {
 
 /// Loads and runs a scene: Err(line) for a refusal, Ok(Some(line)) for a run that stopped,
 /// Ok(None) for one that finished; every body's state is checked finite either way.
-fn outcome(path: &PathBuf) -> Result<Option<String>, String> {
+fn outcome(path: &std::path::Path) -> Result<Option<String>, String> {
     let mut scene = load(path.to_str().unwrap()).map_err(|e| e.to_string())?;
     let steps = (scene.duration / scene.dt).ceil() as usize;
     let mut stopped = None;
