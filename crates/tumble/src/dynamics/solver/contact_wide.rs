@@ -151,11 +151,9 @@ impl ContactLanes {
             slot0,
             slots,
         };
-        // Filled by `default` rather than by copies of one value: zeroing is cheaper than
-        // copying 1.5 kB a slot.
-        self.slots.resize_with(slot0 + slots, Point::default);
-        self.masks.resize_with(slot0 + slots, Masks::default);
-        self.cold.resize_with(slot0 + slots, Sums::default);
+        self.slots.resize(slot0 + slots, Point::default());
+        self.masks.resize(slot0 + slots, Masks::default());
+        self.cold.resize(slot0 + slots, Sums::default());
         for (l, c) in cs.iter().enumerate() {
             for (j, i) in c.range().enumerate() {
                 self.slots[slot0 + j].set_lane(l, &hot[i]);
