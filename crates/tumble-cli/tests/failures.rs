@@ -163,3 +163,38 @@ fn view_serves_an_unstable_run_up_to_its_failure_and_exits_1() {
     assert_eq!(failed_step(err.trim_end()), 1);
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// The corpus of scenes that once ended in NaN with exit 0 (`crates/tumble-scene/tests/corpus`,
+/// named by what must happen): `refused_*` exit 2, `stops_*` exit 1, `runs_*` exit 0, each
+/// with one line on standard error when it fails and whole, finite rows in `--out`.
+#[test]
+fn the_nan_corpus_exits_as_its_names_say_and_never_writes_a_non_finite_number() {
+    let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tumble-scene/tests/corpus");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&corpus)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    assert!(files.len() >= 20);
+    let dir = scratch("nan-corpus");
+    let single = std::mem::size_of::<tumble::Real>() == 4;
+    for scene in files {
+        let name = scene.file_name().unwrap().to_str().unwrap().to_string();
+        let out = dir.join(name.replace(".json", ".csv"));
+        let run = tumble(&["run", path(&scene), "--out", path(&out), "--quiet"]);
+        let code = run.status.code();
+        let want = match name.split('_').next().unwrap() {
+            "refused" => 2,
+            "stops" => 1,
+            _ if single && name.contains("flat_hull") => code.unwrap_or(-1).min(2),
+            _ => 0,
+        };
+        assert_eq!(code, Some(want), "{name}: {}", common::stderr(&run));
+        if want != 0 {
+            assert_eq!(common::stderr(&run).trim_end().lines().count(), 1, "{name}");
+        }
+        if out.exists() {
+            whole_rows(&out);
+        }
+    }
+}
