@@ -2,8 +2,10 @@
 //! numpy arrays, errors as ValueError/TypeError naming the field.
 
 use numpy::{PyArray1, PyArrayMethods};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::intern;
 use pyo3::prelude::*;
+use pyo3::types::{PyFloat, PyInt};
 use tumble::{Mat3, Quat, Real, Vec3};
 
 /// A Python float as the core's number type.
@@ -19,9 +21,50 @@ pub fn wide(x: Real) -> f64 {
     x as f64
 }
 
-/// The core's refusal, whose text already names the field (`shape.radius: must be > 0`).
+pyo3::create_exception!(
+    tumble,
+    SimulationError,
+    PyRuntimeError,
+    "A step whose result was not finite or faster than the world's speed limits; the step \
+     was undone, so the world is as it was after the last good step. The message names the \
+     step, the time, the body and the quantity (`step 41 (t = 0.683 s): bodies[7] \"pelvis\": \
+     velocity is not finite`); so do the attributes `step`, `time` (s), `body` (index in \
+     creation order), `name`, `quantity` and `problem`. From `simulate`, `trajectory` is the \
+     run recorded up to the last good step (None elsewhere)."
+);
+
+/// The core's refusal, whose text already names the field (`shape.radius: must be > 0`);
+/// a step that broke the finite-state invariant is a SimulationError, not bad input.
 pub fn engine(e: tumble::Error) -> PyErr {
-    PyValueError::new_err(e.to_string())
+    match e {
+        tumble::Error::Unstable(u) => Python::attach(|py| unstable(py, &u, None)),
+        other => PyValueError::new_err(other.to_string()),
+    }
+}
+
+/// A SimulationError carrying where and when the step failed, as attributes as well as in
+/// its one-line message, so a caller can react (smaller dt, that body) without parsing.
+pub fn unstable(
+    py: Python<'_>,
+    u: &tumble::error::Unstable,
+    trajectory: Option<Py<PyAny>>,
+) -> PyErr {
+    let message = tumble::Error::Unstable(Box::new(u.clone())).to_string();
+    let err = SimulationError::new_err(message);
+    let set = || -> PyResult<()> {
+        let v = err.value(py);
+        v.setattr("step", u.step)?;
+        v.setattr("time", wide(u.time))?;
+        v.setattr("body", u.index)?;
+        v.setattr("name", u.name.as_deref())?;
+        v.setattr("quantity", u.quantity)?;
+        v.setattr("problem", u.problem.as_str())?;
+        v.setattr("trajectory", trajectory)
+    };
+    match set() {
+        Ok(()) => err,
+        Err(e) => e,
+    }
 }
 
 /// The scene loader's refusal, `bodies[3].shape.radius: must be > 0`.
@@ -44,12 +87,57 @@ pub fn wrong_type(field: &str, expected: &str, got: &Bound<'_, PyAny>) -> PyErr 
     PyTypeError::new_err(format!("{field}: expected {expected}, got {type_name}"))
 }
 
+/// What a numpy array's or scalar's dtype holds when it is not real numbers (`complex
+/// numbers (complex128)`), or None for real numbers and for anything that is not numpy's.
+/// numpy casts complex to float by dropping the imaginary part and strings to float by
+/// parsing them; a position given as either is a mistake to report, not to guess at.
+pub fn unreal_dtype(obj: &Bound<'_, PyAny>) -> Option<String> {
+    let dtype = obj.getattr(intern!(obj.py(), "dtype")).ok()?;
+    let kind: String = dtype
+        .getattr(intern!(obj.py(), "kind"))
+        .ok()?
+        .extract()
+        .ok()?;
+    let what = match kind.as_str() {
+        // bool, signed and unsigned integers, floats: numbers as Python's int and float are.
+        "b" | "i" | "u" | "f" => return None,
+        "c" => "complex numbers",
+        "U" | "S" => "strings",
+        "O" => "Python objects",
+        "M" | "m" => "dates or times",
+        _ => "raw data",
+    };
+    let name = dtype.str().map(|s| s.to_string()).unwrap_or(kind);
+    Some(format!("{what} ({name})"))
+}
+
+/// A TypeError for a value holding `what` (from [`unreal_dtype`]) where numbers belong.
+pub fn not_real(field: &str, expected: &str, what: &str) -> PyErr {
+    PyTypeError::new_err(format!("{field}: expected {expected}, got {what}"))
+}
+
 /// `n` numbers from any sequence or 1-D array.
 pub fn numbers(obj: &Bound<'_, PyAny>, field: &str, n: usize, what: &str) -> PyResult<Vec<f64>> {
     if obj.is_instance_of::<pyo3::types::PyString>() {
         return Err(wrong_type(field, what, obj));
     }
-    let v: Vec<f64> = obj.extract().map_err(|_| wrong_type(field, what, obj))?;
+    if let Some(got) = unreal_dtype(obj) {
+        return Err(not_real(field, what, &got));
+    }
+    let items: Vec<Bound<'_, PyAny>> = obj.extract().map_err(|_| wrong_type(field, what, obj))?;
+    let v = items
+        .iter()
+        .map(|x| {
+            // Python's float and int are the common case; anything else may be a numpy
+            // scalar, whose complex kind would convert with its imaginary part dropped.
+            if !(x.is_exact_instance_of::<PyFloat>() || x.is_instance_of::<PyInt>()) {
+                if let Some(got) = unreal_dtype(x) {
+                    return Err(not_real(field, what, &got));
+                }
+            }
+            x.extract::<f64>().map_err(|_| wrong_type(field, what, obj))
+        })
+        .collect::<PyResult<Vec<f64>>>()?;
     if v.len() != n {
         return Err(invalid(
             field,

@@ -10,7 +10,7 @@ use tumble::{BodyId, JointDef, JointId, JointKind, Quat, Vec3};
 
 use crate::body::{handle, PyBody};
 use crate::convert::{engine, invalid, numbers, real, vec3, vec3_out, wrong_type};
-use crate::world::{body_arg, Inner, PyWorld};
+use crate::world::{body_arg, checked_name, Inner, PyWorld};
 
 /// A velocity motor on a hinge or slider: drive the joint at `speed` (rad/s or m/s) with
 /// at most `max_force` (N·m for hinges, N for sliders).
@@ -334,7 +334,7 @@ impl PyWorld {
                 None => qb.inverse() * (qa * axis),
             };
             let def = JointDef {
-                name,
+                name: checked_name(name, "joints")?,
                 kind,
                 body: a,
                 anchor,

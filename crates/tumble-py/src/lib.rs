@@ -9,11 +9,13 @@
 //! `python/tumble/_tumble.pyi`; keep the two in step.
 
 mod body;
+mod bulk;
 mod convert;
 mod joints;
 mod query;
 mod shapes;
 mod sim;
+mod steps;
 mod world;
 
 use pyo3::prelude::*;
@@ -33,6 +35,10 @@ fn tumble_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SCENES", tumble_scene::builtin_names())?;
     // Whether the core was built with f32 numbers; arrays are float64 either way.
     m.add("SINGLE_PRECISION", std::mem::size_of::<tumble::Real>() == 4)?;
+    m.add(
+        "SimulationError",
+        m.py().get_type::<convert::SimulationError>(),
+    )?;
     shapes::register(m)?;
     world::register(m)?;
     body::register(m)?;

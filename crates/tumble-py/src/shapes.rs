@@ -5,7 +5,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use tumble::{CompoundChild, HeightField, Shape, TriMesh, Vec3};
 
-use crate::convert::{engine, invalid, points, quat_or, real, vec3, vec3_or, wide, wrong_type};
+use crate::convert::{
+    engine, invalid, not_real, points, quat_or, real, unreal_dtype, vec3, vec3_or, wide, wrong_type,
+};
 
 /// A collision shape. Make one with a subclass: Sphere, Box, Capsule, Cylinder, ConvexHull,
 /// Compound, Plane, TriMesh or HeightField. Shapes are immutable and may be shared by bodies.
@@ -251,6 +253,9 @@ impl HeightFieldShape {
         let expected = "a 2-D array of heights (rows, cols)";
         if heights.is_instance_of::<pyo3::types::PyString>() {
             return Err(wrong_type("heights", expected, heights));
+        }
+        if let Some(got) = unreal_dtype(heights) {
+            return Err(not_real("heights", expected, &got));
         }
         let rows: Vec<Vec<f64>> = heights
             .extract()

@@ -1,13 +1,16 @@
-//! Runs and bulk state: `World.simulate` (the loop in Rust, the interpreter's lock
-//! released), its `Trajectory`, and every body's state as one numpy array, readable and
-//! settable without a Python loop.
+//! Runs: `World.simulate` (the loop in Rust, the interpreter's lock released, Ctrl-C
+//! looked for between steps) and its `Trajectory`. A recording that could not fit in the
+//! machine's memory is refused before anything is allocated.
 
-use numpy::{AllowTypeChange, PyArray1, PyArrayLike2, PyArrayMethods};
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::exceptions::PyMemoryError;
+use pyo3::intern;
 use pyo3::prelude::*;
-use tumble::{Body, BodyId, Quat, Real, Vec3, World};
+use tumble::{Quat, Real, Vec3, World};
 use tumble_scene::RunPlan;
 
-use crate::convert::{engine, invalid, real, scene, wide};
+use crate::convert::{invalid, real, scene, unstable, wide};
+use crate::steps::Stop;
 use crate::world::PyWorld;
 
 /// A recorded run: step 0, every `every`-th step and the last. `time` (T,) in s;
@@ -70,28 +73,39 @@ struct Recording {
     angular_momentum: Vec<f64>,
 }
 
-fn push3(out: &mut Vec<f64>, v: Vec3) {
+pub fn push3(out: &mut Vec<f64>, v: Vec3) {
     out.extend_from_slice(&[wide(v.x), wide(v.y), wide(v.z)]);
 }
 
-fn push4(out: &mut Vec<f64>, q: Quat) {
+pub fn push4(out: &mut Vec<f64>, q: Quat) {
     out.extend_from_slice(&[wide(q.x), wide(q.y), wide(q.z), wide(q.w)]);
 }
 
 impl Recording {
-    fn with_capacity(frames: usize, bodies: usize, diagnostics: bool) -> Self {
-        let per = frames * bodies;
+    /// Buffers for the whole run, reserved up front so that recording allocates nothing; a
+    /// reservation the allocator refuses is an error here, where `Vec::with_capacity`
+    /// would abort the interpreter.
+    fn with_capacity(
+        frames: usize,
+        bodies: usize,
+        diagnostics: bool,
+    ) -> Result<Self, std::collections::TryReserveError> {
+        let per = frames.saturating_mul(bodies);
         let d = if diagnostics { frames } else { 0 };
-        Recording {
-            time: Vec::with_capacity(frames),
-            position: Vec::with_capacity(per * 3),
-            orientation: Vec::with_capacity(per * 4),
-            velocity: Vec::with_capacity(per * 3),
-            angular_velocity: Vec::with_capacity(per * 3),
-            energy: std::array::from_fn(|_| Vec::with_capacity(d)),
-            linear_momentum: Vec::with_capacity(d * 3),
-            angular_momentum: Vec::with_capacity(d * 3),
+        let mut rec = Recording::default();
+        rec.time.try_reserve_exact(frames)?;
+        rec.position.try_reserve_exact(per.saturating_mul(3))?;
+        rec.orientation.try_reserve_exact(per.saturating_mul(4))?;
+        rec.velocity.try_reserve_exact(per.saturating_mul(3))?;
+        rec.angular_velocity
+            .try_reserve_exact(per.saturating_mul(3))?;
+        for e in &mut rec.energy {
+            e.try_reserve_exact(d)?;
         }
+        rec.linear_momentum.try_reserve_exact(d.saturating_mul(3))?;
+        rec.angular_momentum
+            .try_reserve_exact(d.saturating_mul(3))?;
+        Ok(rec)
     }
 
     fn frame(&mut self, world: &World, time: Real, diagnostics: bool) {
@@ -113,118 +127,147 @@ impl Recording {
     }
 }
 
-/// Steps `world` through `plan`, recording step 0, every `every`-th step and the last.
+/// The frames a run of `steps` records with `every`: step 0, every `every`-th step, the
+/// last.
+fn frame_count(steps: u64, every: u64) -> u64 {
+    steps / every + 1 + u64::from(steps % every != 0)
+}
+
+/// Bytes a recording of `frames` frames of `bodies` bodies takes: per frame its time, 13
+/// numbers per body (position 3, orientation 4, velocity 3, angular velocity 3) and with
+/// diagnostics 9 more (three energies, two momenta), 8 bytes each. In u128, so that no
+/// request, however absurd, overflows on its way to being refused.
+fn recording_bytes(frames: u64, bodies: usize, diagnostics: bool) -> u128 {
+    let per_frame = 1 + 13 * bodies as u128 + if diagnostics { 9 } else { 0 };
+    frames as u128 * per_frame * 8
+}
+
+/// The machine's physical memory (bytes), or None where Python's `os.sysconf` cannot say
+/// (Windows); there a recording too large is left to the allocator (MemoryError).
+fn physical_memory(py: Python<'_>) -> Option<u128> {
+    let os = py.import(intern!(py, "os")).ok()?;
+    let sysconf = |name: &str| -> Option<u128> {
+        let v: i64 = os.call_method1("sysconf", (name,)).ok()?.extract().ok()?;
+        u128::try_from(v).ok()
+    };
+    Some(sysconf("SC_PHYS_PAGES")? * sysconf("SC_PAGE_SIZE")?)
+}
+
+/// A size in bytes as people say it: `52.8 GB`.
+fn size(bytes: u128) -> String {
+    let b = bytes as f64;
+    if b >= 1e12 {
+        format!("{:.1} TB", b / 1e12)
+    } else if b >= 1e9 {
+        format!("{:.1} GB", b / 1e9)
+    } else {
+        format!("{:.1} MB", b / 1e6)
+    }
+}
+
+/// Refuses, before anything is allocated, a recording larger than the machine's memory.
+/// Reserving it would abort the interpreter (Rust aborts when an allocation fails) or,
+/// under overcommit, succeed and end in the out-of-memory killer far into the run.
+/// `field` is the argument that asked for the run (`steps` or `duration`).
+fn check_fits(
+    py: Python<'_>,
+    field: &str,
+    frames: u64,
+    bodies: usize,
+    diagnostics: bool,
+) -> PyResult<()> {
+    let bytes = recording_bytes(frames, bodies, diagnostics);
+    match physical_memory(py) {
+        Some(memory) if bytes > memory => Err(invalid(
+            field,
+            format!(
+                "recording {frames} frames of {bodies} bodies would take {}, more than this \
+                 machine's {} of memory; record every k-th step with every=k, or simulate \
+                 in shorter runs",
+                size(bytes),
+                size(memory)
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Steps `world` through `plan` into `rec`, recording step 0, every `every`-th step and the
+/// last, with the interpreter's lock released and Ctrl-C looked for between steps. When
+/// it stops early, `rec` holds every frame up to the last good step.
 fn run(
+    py: Python<'_>,
     world: &mut World,
-    plan: &RunPlan,
+    plan: RunPlan,
     every: u64,
     diagnostics: bool,
-) -> tumble::Result<Recording> {
-    let frames = plan.steps / every + 1 + u64::from(plan.steps % every != 0);
-    let mut rec = Recording::with_capacity(frames as usize, world.body_count(), diagnostics);
+    rec: &mut Recording,
+) -> Result<(), Stop> {
     let start = world.time();
     rec.frame(world, start, diagnostics);
-    for k in 1..=plan.steps {
-        world.step(plan.step_dt(k))?;
+    let dt = |k| plan.step_dt(k);
+    let record = |k: u64, world: &World| {
         if k % every == 0 || k == plan.steps {
             // k·dt from the start rather than the world's running sum, as the CLI reports.
             rec.frame(world, start + plan.time_after(k), diagnostics);
         }
-    }
-    Ok(rec)
+    };
+    crate::steps::run(py, world, plan.steps, true, dt, record)
 }
 
-fn array(py: Python<'_>, data: Vec<f64>, shape: &[usize]) -> PyResult<Py<PyAny>> {
+pub fn array(py: Python<'_>, data: Vec<f64>, shape: &[usize]) -> PyResult<Py<PyAny>> {
     Ok(PyArray1::from_vec(py, data)
         .reshape(shape)?
         .into_any()
         .unbind())
 }
 
-/// Rows of a bulk array given for every body: (N, width), converted to float64.
-fn rows<'py>(
-    value: &Bound<'py, PyAny>,
-    field: &str,
-    n: usize,
-    width: usize,
-) -> PyResult<Vec<Vec<f64>>> {
-    let arr: PyArrayLike2<'py, f64, AllowTypeChange> = value.extract().map_err(|_| {
-        crate::convert::wrong_type(field, &format!("an array of shape (N, {width})"), value)
-    })?;
-    let view = arr.as_array();
-    if view.shape() != [n, width] {
-        return Err(invalid(
-            field,
-            format!(
-                "expected an array of shape ({n}, {width}) (one row per body), got {:?}",
-                view.shape()
-            ),
-        ));
-    }
-    let out: Vec<Vec<f64>> = view.rows().into_iter().map(|r| r.to_vec()).collect();
-    // Checked whole before anything is written, so a refused array changes nothing.
-    if let Some(i) = out.iter().position(|r| r.iter().any(|x| !x.is_finite())) {
-        return Err(invalid(&format!("{field}[{i}]"), "must be finite numbers"));
-    }
-    if width == 4 {
-        if let Some(i) = out.iter().position(|r| r.iter().all(|&x| x == 0.0)) {
-            return Err(invalid(
-                &format!("{field}[{i}]"),
-                "must be a non-zero quaternion [x, y, z, w]",
-            ));
+/// A recording as the Trajectory Python sees, its bodies called `names`.
+fn trajectory(
+    py: Python<'_>,
+    rec: Recording,
+    names: Vec<Option<String>>,
+    diagnostics: bool,
+) -> PyResult<Trajectory> {
+    let (t, n) = (rec.time.len(), names.len());
+    let diag = |data: Vec<f64>, shape: &[usize]| -> PyResult<Option<Py<PyAny>>> {
+        diagnostics.then(|| array(py, data, shape)).transpose()
+    };
+    let [kinetic, potential, total] = rec.energy;
+    Ok(Trajectory {
+        time: array(py, rec.time, &[t])?,
+        position: array(py, rec.position, &[t, n, 3])?,
+        orientation: array(py, rec.orientation, &[t, n, 4])?,
+        velocity: array(py, rec.velocity, &[t, n, 3])?,
+        angular_velocity: array(py, rec.angular_velocity, &[t, n, 3])?,
+        kinetic: diag(kinetic, &[t])?,
+        potential: diag(potential, &[t])?,
+        total: diag(total, &[t])?,
+        linear_momentum: diag(rec.linear_momentum, &[t, 3])?,
+        angular_momentum: diag(rec.angular_momentum, &[t, 3])?,
+        names,
+    })
+}
+
+/// The run `simulate` was asked for, and the argument that asked (for its refusals).
+fn plan_of(
+    g: &crate::world::Inner,
+    duration: Option<f64>,
+    dt: Option<f64>,
+    steps: Option<i64>,
+) -> PyResult<(RunPlan, &'static str)> {
+    let dt = dt.map_or(g.dt, real);
+    match (steps, duration) {
+        (Some(_), Some(_)) => Err(invalid("steps", "cannot be given together with duration")),
+        (Some(s), None) => {
+            let s = u64::try_from(s).map_err(|_| invalid("steps", "must be >= 0"))?;
+            Ok((RunPlan::from_steps(s, dt).map_err(scene)?, "steps"))
+        }
+        (None, d) => {
+            let plan = RunPlan::from_duration(d.map_or(g.duration, real), dt).map_err(scene)?;
+            Ok((plan, "duration"))
         }
     }
-    Ok(out)
-}
-
-fn v3(r: &[f64]) -> Vec3 {
-    Vec3::new(real(r[0]), real(r[1]), real(r[2]))
-}
-
-fn read_all(world: &World, width: usize, f: impl Fn(&Body, &mut Vec<f64>)) -> Vec<f64> {
-    let mut out = Vec::with_capacity(world.body_count() * width);
-    for (_, b) in world.bodies() {
-        f(b, &mut out);
-    }
-    out
-}
-
-type Setter = fn(&mut World, BodyId, &[f64]) -> tumble::Result<()>;
-
-fn set_all(
-    w: &PyWorld,
-    value: &Bound<'_, PyAny>,
-    field: &str,
-    width: usize,
-    set: Setter,
-) -> PyResult<()> {
-    let mut g = w.lock()?;
-    let n = g.world.body_count();
-    let data = rows(value, field, n, width)?;
-    let ids = g.world.body_ids().to_vec();
-    for (i, (id, r)) in ids.iter().zip(&data).enumerate() {
-        set(&mut g.world, *id, r).map_err(|e| match e {
-            tumble::Error::InvalidField { reason, .. } => invalid(&format!("{field}[{i}]"), reason),
-            other => engine(other),
-        })?;
-    }
-    Ok(())
-}
-
-fn set_position(w: &mut World, id: BodyId, r: &[f64]) -> tumble::Result<()> {
-    w.set_position(id, v3(r))
-}
-fn set_orientation(w: &mut World, id: BodyId, r: &[f64]) -> tumble::Result<()> {
-    w.set_orientation(
-        id,
-        Quat::from_xyzw(real(r[0]), real(r[1]), real(r[2]), real(r[3])),
-    )
-}
-fn set_velocity(w: &mut World, id: BodyId, r: &[f64]) -> tumble::Result<()> {
-    w.set_linear_velocity(id, v3(r))
-}
-fn set_angular_velocity(w: &mut World, id: BodyId, r: &[f64]) -> tumble::Result<()> {
-    w.set_angular_velocity(id, v3(r))
 }
 
 #[pymethods]
@@ -234,6 +277,10 @@ impl PyWorld {
     /// recorded Trajectory. The loop runs in Rust with the interpreter's lock released.
     /// As with the CLI, a duration that is not a whole number of steps ends with one
     /// shorter step; `every` records every k-th step (step 0 and the last always).
+    /// A recording larger than the machine's memory is refused (ValueError) before the
+    /// run; Ctrl-C stops the run between two steps (KeyboardInterrupt); a step that is
+    /// not finite or too fast raises SimulationError, whose `trajectory` is the run up to
+    /// the last good step. The world is left at the last step completed.
     #[pyo3(signature = (duration = None, dt = None, *, steps = None, every = 1, diagnostics = false))]
     fn simulate(
         slf: &Bound<'_, Self>,
@@ -244,137 +291,31 @@ impl PyWorld {
         diagnostics: bool,
     ) -> PyResult<Trajectory> {
         let py = slf.py();
-        if every < 1 {
-            return Err(invalid("every", "must be >= 1"));
-        }
+        let every = u64::try_from(every)
+            .ok()
+            .filter(|&e| e >= 1)
+            .ok_or_else(|| invalid("every", "must be >= 1"))?;
         let mut g = slf.get().lock()?;
-        let dt = dt.map_or(g.dt, real);
-        let plan = match (steps, duration) {
-            (Some(_), Some(_)) => {
-                return Err(invalid("steps", "cannot be given together with duration"))
-            }
-            (Some(s), None) => {
-                let s = u64::try_from(s).map_err(|_| invalid("steps", "must be >= 0"))?;
-                RunPlan::from_steps(s, dt)
-            }
-            (None, d) => RunPlan::from_duration(d.map_or(g.duration, real), dt),
-        }
-        .map_err(scene)?;
-        let world = &mut g.world;
-        let rec = py
-            .detach(|| run(world, &plan, every as u64, diagnostics))
-            .map_err(engine)?;
+        let (plan, field) = plan_of(&g, duration, dt, steps)?;
+        let frames = frame_count(plan.steps, every);
+        check_fits(py, field, frames, g.world.body_count(), diagnostics)?;
+        let mut rec = Recording::with_capacity(frames as usize, g.world.body_count(), diagnostics)
+            .map_err(|e| PyMemoryError::new_err(format!("{field}: the recording: {e}")))?;
+        let outcome = run(py, &mut g.world, plan, every, diagnostics, &mut rec);
         let names = g
             .world
             .bodies()
             .map(|(_, b)| b.name().map(str::to_string))
             .collect();
-        let (t, n) = (rec.time.len(), g.world.body_count());
-        let diag = |data: Vec<f64>, shape: &[usize]| -> PyResult<Option<Py<PyAny>>> {
-            diagnostics.then(|| array(py, data, shape)).transpose()
-        };
-        let [kinetic, potential, total] = rec.energy;
-        Ok(Trajectory {
-            time: array(py, rec.time, &[t])?,
-            position: array(py, rec.position, &[t, n, 3])?,
-            orientation: array(py, rec.orientation, &[t, n, 4])?,
-            velocity: array(py, rec.velocity, &[t, n, 3])?,
-            angular_velocity: array(py, rec.angular_velocity, &[t, n, 3])?,
-            kinetic: diag(kinetic, &[t])?,
-            potential: diag(potential, &[t])?,
-            total: diag(total, &[t])?,
-            linear_momentum: diag(rec.linear_momentum, &[t, 3])?,
-            angular_momentum: diag(rec.angular_momentum, &[t, 3])?,
-            names,
-        })
-    }
-
-    /// Every body frame's origin (m), float64 array (N, 3) in creation order; assignable
-    /// with any (N, 3) array (checked whole before anything changes).
-    #[getter]
-    fn positions(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        let g = self.lock()?;
-        let data = read_all(&g.world, 3, |b, o| push3(o, b.position()));
-        array(py, data, &[g.world.body_count(), 3])
-    }
-
-    #[setter]
-    fn set_positions(&self, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        set_all(self, value, "positions", 3, set_position)
-    }
-
-    /// Every body's orientation [x, y, z, w], float64 array (N, 4); assignable.
-    #[getter]
-    fn orientations(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        let g = self.lock()?;
-        let data = read_all(&g.world, 4, |b, o| push4(o, b.orientation()));
-        array(py, data, &[g.world.body_count(), 4])
-    }
-
-    #[setter]
-    fn set_orientations(&self, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        set_all(self, value, "orientations", 4, set_orientation)
-    }
-
-    /// Every body's centre-of-mass velocity (m/s), float64 array (N, 3); assignable.
-    #[getter]
-    fn velocities(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        let g = self.lock()?;
-        let data = read_all(&g.world, 3, |b, o| push3(o, b.linear_velocity()));
-        array(py, data, &[g.world.body_count(), 3])
-    }
-
-    #[setter]
-    fn set_velocities(&self, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        set_all(self, value, "velocities", 3, set_velocity)
-    }
-
-    /// Every body's angular velocity (rad/s, world frame), float64 array (N, 3);
-    /// assignable.
-    #[getter]
-    fn angular_velocities(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        let g = self.lock()?;
-        let data = read_all(&g.world, 3, |b, o| push3(o, b.angular_velocity()));
-        array(py, data, &[g.world.body_count(), 3])
-    }
-
-    #[setter]
-    fn set_angular_velocities(&self, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        set_all(self, value, "angular_velocities", 3, set_angular_velocity)
-    }
-
-    /// Every body's angular momentum about its centre of mass (kg·m²/s, world frame),
-    /// float64 array (N, 3).
-    #[getter]
-    fn angular_momenta(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        let g = self.lock()?;
-        let data = read_all(&g.world, 3, |b, o| push3(o, b.angular_momentum()));
-        array(py, data, &[g.world.body_count(), 3])
-    }
-
-    /// Sets any of the bulk arrays at once, in the order positions, orientations,
-    /// velocities, angular velocities (so ω is turned into L with the new orientation).
-    #[pyo3(signature = (*, positions = None, orientations = None, velocities = None, angular_velocities = None))]
-    fn set_state(
-        &self,
-        positions: Option<&Bound<'_, PyAny>>,
-        orientations: Option<&Bound<'_, PyAny>>,
-        velocities: Option<&Bound<'_, PyAny>>,
-        angular_velocities: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<()> {
-        if let Some(v) = positions {
-            self.set_positions(v)?;
+        drop(g);
+        match outcome {
+            Ok(()) => trajectory(py, rec, names, diagnostics),
+            Err(Stop::Engine(tumble::Error::Unstable(u))) => {
+                let partial = Py::new(py, trajectory(py, rec, names, diagnostics)?)?;
+                Err(unstable(py, &u, Some(partial.into_any())))
+            }
+            Err(stop) => Err(stop.into()),
         }
-        if let Some(v) = orientations {
-            self.set_orientations(v)?;
-        }
-        if let Some(v) = velocities {
-            self.set_velocities(v)?;
-        }
-        if let Some(v) = angular_velocities {
-            self.set_angular_velocities(v)?;
-        }
-        Ok(())
     }
 }
 

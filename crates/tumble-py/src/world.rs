@@ -8,7 +8,7 @@ use pyo3::exceptions::{PyKeyError, PyRuntimeError};
 use pyo3::prelude::*;
 use tumble::{
     AppliedForce, BodyDef, BodyId, BodyKind, Drag, Force, ForceId, InertiaSpec, MassSpec, Real,
-    SolverSettings, Spring, SpringEnd, Vec3, World, WorldDef,
+    SolverSettings, SpeedLimits, Spring, SpringEnd, Vec3, World, WorldDef,
 };
 
 use crate::body::{handle, PyBody};
@@ -32,7 +32,10 @@ pub struct Inner {
 /// World(*, gravity=(0, -9.8, 0), integrator="symplectic_euler", solver="soft_step",
 /// substeps=4, iterations=1, contact_hertz=60.0, contact_damping_ratio=10.0,
 /// joint_hertz=1000.0, joint_damping_ratio=0.5, baumgarte=0.2, length_unit=1.0,
-/// sleep=True). SI units throughout; quaternions are [x, y, z, w].
+/// sleep=True, max_speed=None, max_angular_speed=None). SI units throughout; quaternions
+/// are [x, y, z, w]. `max_speed` (m/s) and `max_angular_speed` (rad/s) bound every body's
+/// speed (defaults 1e4·length_unit and 1e5): a step that exceeds them, or whose result is
+/// not finite, is undone and raises SimulationError.
 #[pyclass(module = "tumble", name = "World", frozen)]
 pub struct PyWorld {
     // A Mutex rather than PyO3's borrow flag: the engine's World is Send but not Sync
@@ -88,6 +91,34 @@ pub fn body_arg(
             .ok_or_else(|| invalid(field, format!("no body named '{name}'")));
     }
     Err(wrong_type(field, "a tumble.Body or a body's name", obj))
+}
+
+/// A body's or joint's name (`of`: "bodies" or "joints"), refused as a scene file refuses
+/// it (`name: must not be empty`): names label output rows, where the unnamed are labelled
+/// by their index, so the rule is the scene format's, from its own function.
+pub fn checked_name(name: Option<String>, of: &str) -> PyResult<Option<String>> {
+    if let Some(n) = &name {
+        tumble_scene::check_name(n, of).map_err(|reason| invalid("name", reason))?;
+    }
+    Ok(name)
+}
+
+/// The speed limits given, each defaulting to the engine's for `length_unit`, or `None`
+/// (all the engine's defaults) when neither is given, as in a scene file.
+fn speed_limits(
+    max_speed: Option<f64>,
+    max_angular_speed: Option<f64>,
+    length_unit: f64,
+) -> Option<SpeedLimits> {
+    if max_speed.is_none() && max_angular_speed.is_none() {
+        return None;
+    }
+    // A bad length_unit is refused by the engine before the limits are looked at.
+    let default = SpeedLimits::for_length_unit(real(length_unit));
+    Some(SpeedLimits {
+        max_speed: max_speed.map_or(default.max_speed, real),
+        max_angular_speed: max_angular_speed.map_or(default.max_angular_speed, real),
+    })
 }
 
 /// A count such as `substeps`, at least 1.
@@ -267,7 +298,8 @@ impl PyWorld {
     #[pyo3(signature = (*, gravity = None, integrator = "symplectic_euler".to_string(),
         solver = "soft_step".to_string(), substeps = 4, iterations = 1, contact_hertz = 60.0,
         contact_damping_ratio = 10.0, joint_hertz = 1000.0, joint_damping_ratio = 0.5,
-        baumgarte = 0.2, length_unit = 1.0, sleep = true))]
+        baumgarte = 0.2, length_unit = 1.0, sleep = true, max_speed = None,
+        max_angular_speed = None))]
     #[allow(clippy::too_many_arguments)]
     fn py_new(
         gravity: Option<&Bound<'_, PyAny>>,
@@ -282,6 +314,8 @@ impl PyWorld {
         baumgarte: f64,
         length_unit: f64,
         sleep: bool,
+        max_speed: Option<f64>,
+        max_angular_speed: Option<f64>,
     ) -> PyResult<Self> {
         let settings = PySolverSettings {
             kind: solver,
@@ -299,7 +333,7 @@ impl PyWorld {
             length_unit: real(length_unit),
             solver: settings.to_core()?,
             sleep,
-            limits: None,
+            limits: speed_limits(max_speed, max_angular_speed, length_unit),
         };
         let world = World::try_new(&def).map_err(engine)?;
         Ok(PyWorld::new_inner(Inner {
@@ -389,7 +423,7 @@ impl PyWorld {
         })?;
         let inertia = inertia.map(inertia_spec).transpose()?;
         let def = BodyDef {
-            name,
+            name: checked_name(name, "bodies")?,
             kind,
             position: vec3_or(position, "position", Vec3::ZERO)?,
             orientation: quat_or(orientation, "orientation")?,
@@ -536,20 +570,21 @@ impl PyWorld {
     }
 
     /// Advances the world by `dt` seconds, `steps` times (default once). Long runs release
-    /// the interpreter lock, so other Python threads go on meanwhile.
+    /// the interpreter lock, so other Python threads go on meanwhile, and stop on Ctrl-C
+    /// (KeyboardInterrupt) between two steps. A step whose result is not finite or too
+    /// fast raises SimulationError with that step undone; either way the world is left at
+    /// the last step completed (`step_count` says which).
     #[pyo3(signature = (dt, steps = 1))]
     fn step(&self, py: Python<'_>, dt: f64, steps: u64) -> PyResult<()> {
         let mut g = self.lock()?;
         let world = &mut g.world;
         let dt = real(dt);
         // Releasing and retaking the interpreter lock costs about what stepping an empty
-        // world does, so a short step keeps it.
-        let result = if (world.body_count() as u64).saturating_mul(steps) >= 64 {
-            py.detach(|| step_n(world, dt, steps))
-        } else {
-            step_n(world, dt, steps)
-        };
-        result.map_err(engine)
+        // world does, so a short step keeps it; counting an empty world as one body, so
+        // that many steps of it (long, however cheap each) let other threads run.
+        let release = (world.body_count().max(1) as u64).saturating_mul(steps) >= 64;
+        crate::steps::run(py, world, steps, release, |_| dt, |_, _| ())?;
+        Ok(())
     }
 
     /// Simulated time (s).
@@ -643,6 +678,40 @@ impl PyWorld {
         self.lock()?.world.set_solver_settings(s).map_err(engine)
     }
 
+    /// The fastest a centre of mass may move (m/s; default 1e4 times `length_unit`): a body
+    /// set faster is refused, a step that makes one faster raises SimulationError. Assignable
+    /// (not below the speed of a body moving now).
+    #[getter]
+    fn max_speed(&self) -> PyResult<f64> {
+        Ok(wide(self.lock()?.world.speed_limits().max_speed))
+    }
+
+    #[setter]
+    fn set_max_speed(&self, value: f64) -> PyResult<()> {
+        let mut g = self.lock()?;
+        let limits = SpeedLimits {
+            max_speed: real(value),
+            ..g.world.speed_limits()
+        };
+        g.world.set_speed_limits(limits).map_err(engine)
+    }
+
+    /// The fastest a body may turn (rad/s; default 1e5), as `max_speed`; assignable.
+    #[getter]
+    fn max_angular_speed(&self) -> PyResult<f64> {
+        Ok(wide(self.lock()?.world.speed_limits().max_angular_speed))
+    }
+
+    #[setter]
+    fn set_max_angular_speed(&self, value: f64) -> PyResult<()> {
+        let mut g = self.lock()?;
+        let limits = SpeedLimits {
+            max_angular_speed: real(value),
+            ..g.world.speed_limits()
+        };
+        g.world.set_speed_limits(limits).map_err(engine)
+    }
+
     /// Speculative contact distance (m): gaps narrower than this count as contacts.
     #[getter]
     fn contact_margin(&self) -> PyResult<f64> {
@@ -694,14 +763,6 @@ fn add(world: &mut World, force: Force) -> PyResult<u64> {
         .add_force(force)
         .map(|id| (id.generation as u64) << 32 | id.index as u64)
         .map_err(engine)
-}
-
-/// `steps` steps of `dt`, stopping at the first refusal.
-pub fn step_n(world: &mut World, dt: Real, steps: u64) -> tumble::Result<()> {
-    for _ in 0..steps {
-        world.step(dt)?;
-    }
-    Ok(())
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -54,7 +54,7 @@ pub(crate) fn body(node: &Node<'_>) -> Result<(BodyDef, Shape)> {
     let obj = node.object()?;
     obj.only(&BODY_KEYS)?;
     let def = BodyDef {
-        name: name(&obj)?,
+        name: name(&obj, "bodies")?,
         kind: kind(&obj)?,
         position: obj.vec3("position")?.unwrap_or(Vec3::ZERO),
         orientation: obj.quat("orientation")?.unwrap_or(Quat::IDENTITY),
@@ -81,25 +81,33 @@ fn bits(obj: &Obj<'_>, key: &str) -> Result<Option<u32>> {
         .transpose()
 }
 
-/// Names label CSV rows, where unnamed bodies are labelled by their index; a name made
-/// of digits could be mistaken for another body's index, so it is refused.
-fn name(obj: &Obj<'_>) -> Result<Option<String>> {
+/// A body's or joint's `name` (`bodies`, `joints` say which, for the message), checked.
+pub(crate) fn name(obj: &Obj<'_>, of: &str) -> Result<Option<String>> {
     let Some(name) = obj.str("name")? else {
         return Ok(None);
     };
+    check_name(name, of).map_err(|reason| obj.err_at("name", reason))?;
+    Ok(Some(name.to_string()))
+}
+
+/// Why `name` cannot name one of `of` (`"bodies"` or `"joints"`), or `Ok`. Names label
+/// CSV rows and messages, where unnamed bodies and joints are labelled by their index: a
+/// name of digits could be mistaken for another's index, an empty one reads as a missing
+/// field, and a control character would break the one-line rows and errors. Python's
+/// `add_body` and `add_joint` call this too, so a name is refused the same everywhere.
+pub fn check_name(name: &str, of: &str) -> std::result::Result<(), String> {
     if name.is_empty() {
-        return Err(obj.err_at("name", "must not be empty"));
+        return Err("must not be empty".into());
     }
     if name.chars().any(char::is_control) {
-        return Err(obj.err_at("name", "must not contain control characters"));
+        return Err("must not contain control characters".into());
     }
     if name.bytes().all(|b| b.is_ascii_digit()) {
-        return Err(obj.err_at(
-            "name",
-            "must not be a plain number (unnamed bodies are labelled by their index)",
+        return Err(format!(
+            "must not be a plain number (unnamed {of} are labelled by their index)"
         ));
     }
-    Ok(Some(name.to_string()))
+    Ok(())
 }
 
 fn kind(obj: &Obj<'_>) -> Result<BodyKind> {

@@ -73,7 +73,7 @@ pub(crate) fn joint(node: &Node<'_>, world: &World) -> Result<JointDef> {
         None => pose_b.1.inverse() * (pose_a.1 * axis),
     };
     Ok(JointDef {
-        name: obj.str("name")?.map(str::to_string),
+        name: crate::body::name(&obj, "joints")?,
         kind,
         body,
         anchor,

@@ -35,6 +35,8 @@ pub use joint::JOINT_TYPES;
 pub use plan::{RunPlan, MAX_STEPS};
 pub use reader::{whole_rule, ROOT};
 pub use shape::SHAPE_TYPES;
+// Python checks the names it is given with the same rule.
+pub use body::check_name;
 
 use reader::{Node, Obj};
 

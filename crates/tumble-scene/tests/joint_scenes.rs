@@ -159,6 +159,10 @@ fn joints_read_from_a_scene_with_defaults_and_named_errors() {
         (r#"{"type": "rope", "body": "a"}"#, "joints[0].type: unknown joint type 'rope' (expected one of: ball, hinge, slider, fixed, distance)"),
         (r#"{"type": "slider", "body": "a", "motor": {"speed": 1, "max_force": -1}}"#, "joints[0].motor.max_force: must be >= 0"),
         (r#"{"type": "ball", "body": "a", "limits": [0, 1]}"#, "joints[0].limits: unknown key"),
+        // Joint rows are labelled by index when unnamed, as bodies are: the same rules.
+        (r#"{"type": "ball", "body": "a", "name": "3"}"#, "joints[0].name: must not be a plain number (unnamed joints are labelled by their index)"),
+        (r#"{"type": "ball", "body": "a", "name": ""}"#, "joints[0].name: must not be empty"),
+        (r#"{"type": "ball", "body": "a", "name": "a\nb"}"#, "joints[0].name: must not contain control characters"),
     ] {
         let json = format!(
             r#"{{"bodies": [{{"name": "a", "shape": {{"type": "sphere", "radius": 0.1}}}}],

@@ -46,7 +46,7 @@ pub use narrow_phase::{ContactPoint, Manifold};
 pub use shape::Convex;
 pub use shape::{CompoundChild, ConvexHull, HeightField, MassProperties, Shape, TriMesh};
 pub use solver::{SolverKind, SolverSettings};
-pub use world::{World, WorldDef};
+pub use world::{bulk::BodyStates, World, WorldDef};
 pub use world_query::{QueryFilter, WorldRayHit, WorldShapeHit};
 
 /// Everything a typical user needs, in one import.

@@ -9,7 +9,9 @@
 
 SI units throughout (m, kg, s, rad, N); quaternions are [x, y, z, w]; arrays are float64.
 Bad input raises ValueError or TypeError whose message starts with the field's name, as
-the command-line program prints it: ``shape.radius: must be > 0``.
+the command-line program prints it: ``shape.radius: must be > 0``. A refused call changes
+nothing. A step whose result is not finite or too fast is undone and raises
+SimulationError (a RuntimeError) naming the step, the time, the body and the quantity.
 """
 
 from ._tumble import (
@@ -34,6 +36,7 @@ from ._tumble import (
     RayHit,
     Shape,
     ShapeHit,
+    SimulationError,
     SolverSettings,
     Sphere,
     Trajectory,
@@ -64,6 +67,7 @@ __all__ = [
     "RayHit",
     "Shape",
     "ShapeHit",
+    "SimulationError",
     "SolverSettings",
     "Sphere",
     "Trajectory",

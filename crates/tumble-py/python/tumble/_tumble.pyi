@@ -19,6 +19,26 @@ QuatLike = Union[Sequence[float], npt.ArrayLike]
 F64Array = npt.NDArray[np.float64]
 BodyLike = Union["Body", str]
 
+class SimulationError(RuntimeError):
+    """A step whose result was not finite or faster than the world's speed limits. The step
+    was undone: the world is as it was after the last good step. The message is one line,
+    ``step 41 (t = 0.683 s): bodies[7] "pelvis": velocity is not finite``."""
+
+    step: int
+    """The failed step's number (the world had taken ``step - 1``)."""
+    time: float
+    """The time the failed step would have reached (s)."""
+    body: int
+    """The body's index in creation order (the row of the bulk arrays)."""
+    name: Optional[str]
+    """The body's name, if it has one."""
+    quantity: str
+    """``position``, ``orientation``, ``velocity``, ``angular_velocity`` or ``angular_momentum``."""
+    problem: str
+    """``is not finite``, or the speed reached against the limit."""
+    trajectory: Optional[Trajectory]
+    """From ``simulate``: the run recorded up to the last good step; otherwise None."""
+
 class Shape:
     """A collision shape; make one with a subclass. Immutable, shareable between bodies."""
 
@@ -308,6 +328,8 @@ class World:
         baumgarte: float = 0.2,
         length_unit: float = 1.0,
         sleep: bool = True,
+        max_speed: Optional[float] = None,
+        max_angular_speed: Optional[float] = None,
     ) -> None: ...
     @staticmethod
     def from_scene(path: Union[str, PathLike[str]]) -> World:
@@ -403,7 +425,8 @@ class World:
     @property
     def joints(self) -> list[Joint]: ...
     def step(self, dt: float, steps: int = 1) -> None:
-        """Advances by `dt` seconds, `steps` times."""
+        """Advances by `dt` seconds, `steps` times; stops on Ctrl-C (KeyboardInterrupt) or
+        an unstable step (SimulationError, that step undone) at the last step completed."""
     def simulate(
         self,
         duration: Optional[float] = None,
@@ -413,7 +436,11 @@ class World:
         every: int = 1,
         diagnostics: bool = False,
     ) -> Trajectory:
-        """Runs in Rust with the interpreter released and returns the recorded trajectory."""
+        """Runs in Rust with the interpreter released and returns the recorded trajectory.
+
+        A recording larger than the machine's memory is refused (ValueError) before the run;
+        Ctrl-C stops it between steps (KeyboardInterrupt); an unstable step raises
+        SimulationError, whose ``trajectory`` is the run up to the last good step."""
     @property
     def positions(self) -> F64Array:
         """(N, 3) body-frame origins (m); assignable."""
@@ -445,7 +472,7 @@ class World:
         velocities: Optional[npt.ArrayLike] = None,
         angular_velocities: Optional[npt.ArrayLike] = None,
     ) -> None:
-        """Sets any of the bulk arrays at once."""
+        """Sets any of the bulk arrays at once; all or nothing (every row is checked first)."""
     def cast_ray(
         self,
         origin: Vec3Like,
@@ -522,6 +549,16 @@ class World:
     def solver_settings(self) -> SolverSettings: ...
     @solver_settings.setter
     def solver_settings(self, settings: SolverSettings) -> None: ...
+    @property
+    def max_speed(self) -> float:
+        """The fastest a centre of mass may move (m/s; default 1e4·length_unit); assignable."""
+    @max_speed.setter
+    def max_speed(self, value: float) -> None: ...
+    @property
+    def max_angular_speed(self) -> float:
+        """The fastest a body may turn (rad/s; default 1e5); assignable."""
+    @max_angular_speed.setter
+    def max_angular_speed(self, value: float) -> None: ...
     @property
     def contact_margin(self) -> float: ...
     def diagnostics(self) -> Diagnostics:

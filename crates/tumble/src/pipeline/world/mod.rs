@@ -20,6 +20,7 @@
 //! `forces.rs` and `joints.rs`; queries in `query.rs`.
 
 mod bodies;
+pub mod bulk;
 mod forces;
 mod invariant;
 mod joints;
