@@ -200,3 +200,50 @@ fn the_nan_corpus_exits_as_its_names_say_and_never_writes_a_non_finite_number() 
         }
     }
 }
+
+/// `n` unit boxes created at one point on a ground, with `extra` top-level keys.
+fn pile_scene(dir: &Path, n: usize, extra: &str) -> PathBuf {
+    let file = dir.join("pile.json");
+    let ground = r#"{"shape": {"type": "plane", "normal": [0, 1, 0]}, "kind": "static"}"#;
+    let unit =
+        r#"{"shape": {"type": "box", "half_extents": [0.5, 0.5, 0.5]}, "position": [0, 0.5, 0]}"#;
+    let bodies: Vec<&str> = std::iter::once(ground)
+        .chain(std::iter::repeat_n(unit, n))
+        .collect();
+    let scene = format!(
+        r#"{{"dt": 0.0166667, "duration": 0.05, {extra} "bodies": [{}]}}"#,
+        bodies.join(",")
+    );
+    std::fs::write(&file, scene).unwrap();
+    file
+}
+
+#[test]
+fn a_pile_at_one_point_runs_and_a_step_past_max_contacts_exits_1() {
+    let dir = scratch("pile");
+    // Every pair of 500 boxes at one point touches: 124,750 manifolds uncapped, some 10,000
+    // kept (max_contacts_per_body 16); the run ends, finite.
+    let scene = pile_scene(&dir, 500, "");
+    let out = dir.join("traj.csv");
+    let run = tumble(&["run", path(&scene), "--out", path(&out), "-q"]);
+    assert_eq!(
+        run.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert_eq!(whole_rows(&out).len(), 4 * 501);
+    // The same with room for 100 manifolds: the first step stops the run, named.
+    let scene = pile_scene(&dir, 40, r#""max_contacts": 100,"#);
+    let line = one_line(1, &["run", path(&scene), "--out", path(&out), "-q"]);
+    assert_eq!(
+        line,
+        "step 1 (t = 0.0166667 s): max_contacts: the step needs more than 100 contact \
+         manifolds; raise max_contacts, or start the bodies apart"
+    );
+    assert_eq!(whole_rows(&out).len(), 41, "the state at t = 0 only");
+    let scene = pile_scene(&dir, 2, r#""max_contacts_per_body": 0,"#);
+    let line = one_line(2, &["run", path(&scene), "-q"]);
+    assert!(line.contains("max_contacts_per_body: "), "{line}");
+    std::fs::remove_dir_all(dir).unwrap();
+}

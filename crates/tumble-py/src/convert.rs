@@ -37,28 +37,38 @@ pyo3::create_exception!(
 /// a step that broke the finite-state invariant is a SimulationError, not bad input.
 pub fn engine(e: tumble::Error) -> PyErr {
     match e {
-        tumble::Error::Unstable(u) => Python::attach(|py| unstable(py, &u, None)),
+        e if e.is_step_failure() => Python::attach(|py| failed_step(py, &e, None)),
         other => PyValueError::new_err(other.to_string()),
     }
 }
 
 /// A SimulationError carrying where and when the step failed, as attributes as well as in
-/// its one-line message, so a caller can react (smaller dt, that body) without parsing.
-pub fn unstable(
-    py: Python<'_>,
-    u: &tumble::error::Unstable,
-    trajectory: Option<Py<PyAny>>,
-) -> PyErr {
-    let message = tumble::Error::Unstable(Box::new(u.clone())).to_string();
-    let err = SimulationError::new_err(message);
+/// its one-line message, so a caller can react (smaller dt, that body) without parsing. A
+/// step past `max_contacts` has `quantity` "contacts" and no body.
+pub fn failed_step(py: Python<'_>, e: &tumble::Error, trajectory: Option<Py<PyAny>>) -> PyErr {
+    let err = SimulationError::new_err(e.to_string());
     let set = || -> PyResult<()> {
         let v = err.value(py);
-        v.setattr("step", u.step)?;
-        v.setattr("time", wide(u.time))?;
-        v.setattr("body", u.index)?;
-        v.setattr("name", u.name.as_deref())?;
-        v.setattr("quantity", u.quantity)?;
-        v.setattr("problem", u.problem.as_str())?;
+        match e {
+            tumble::Error::Unstable(u) => {
+                v.setattr("step", u.step)?;
+                v.setattr("time", wide(u.time))?;
+                v.setattr("body", u.index)?;
+                v.setattr("name", u.name.as_deref())?;
+                v.setattr("quantity", u.quantity)?;
+                v.setattr("problem", u.problem.as_str())?;
+            }
+            tumble::Error::TooManyContacts(c) => {
+                v.setattr("step", c.step)?;
+                v.setattr("time", wide(c.time))?;
+                v.setattr("body", py.None())?;
+                v.setattr("name", py.None())?;
+                v.setattr("quantity", "contacts")?;
+                let problem = format!("more than max_contacts = {} manifolds", c.limit);
+                v.setattr("problem", problem)?;
+            }
+            _ => {}
+        }
         v.setattr("trajectory", trajectory)
     };
     match set() {

@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use tumble::{Quat, Real, Vec3, World};
 use tumble_scene::RunPlan;
 
-use crate::convert::{invalid, real, scene, unstable, wide};
+use crate::convert::{failed_step, invalid, real, scene, wide};
 use crate::steps::Stop;
 use crate::world::PyWorld;
 
@@ -310,9 +310,9 @@ impl PyWorld {
         drop(g);
         match outcome {
             Ok(()) => trajectory(py, rec, names, diagnostics),
-            Err(Stop::Engine(tumble::Error::Unstable(u))) => {
+            Err(Stop::Engine(e)) if e.is_step_failure() => {
                 let partial = Py::new(py, trajectory(py, rec, names, diagnostics)?)?;
-                Err(unstable(py, &u, Some(partial.into_any())))
+                Err(failed_step(py, &e, Some(partial.into_any())))
             }
             Err(stop) => Err(stop.into()),
         }

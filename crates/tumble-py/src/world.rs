@@ -6,6 +6,7 @@ use std::sync::{Mutex, MutexGuard, TryLockError};
 use numpy::PyArray1;
 use pyo3::exceptions::{PyKeyError, PyRuntimeError};
 use pyo3::prelude::*;
+use tumble::limits::ContactLimits;
 use tumble::{
     AppliedForce, BodyDef, BodyId, BodyKind, Drag, Force, ForceId, InertiaSpec, MassSpec, Real,
     SolverSettings, SpeedLimits, Spring, SpringEnd, Vec3, World, WorldDef,
@@ -32,10 +33,13 @@ pub struct Inner {
 /// World(*, gravity=(0, -9.8, 0), integrator="symplectic_euler", solver="soft_step",
 /// substeps=4, iterations=1, contact_hertz=60.0, contact_damping_ratio=10.0,
 /// joint_hertz=1000.0, joint_damping_ratio=0.5, baumgarte=0.2, length_unit=1.0,
-/// sleep=True, max_speed=None, max_angular_speed=None). SI units throughout; quaternions
-/// are [x, y, z, w]. `max_speed` (m/s) and `max_angular_speed` (rad/s) bound every body's
-/// speed (defaults 1e4·length_unit and 1e5): a step that exceeds them, or whose result is
-/// not finite, is undone and raises SimulationError.
+/// sleep=True, max_speed=None, max_angular_speed=None, max_contacts=None,
+/// max_contacts_per_body=None). SI units throughout; quaternions are [x, y, z, w].
+/// `max_speed` (m/s) and `max_angular_speed` (rad/s) bound every body's speed (defaults
+/// 1e4·length_unit and 1e5): a step that exceeds them, or whose result is not finite, is
+/// undone and raises SimulationError; so is one needing more than `max_contacts` contact
+/// manifolds (default 1,048,576). `max_contacts_per_body` (default 16) is how many other
+/// bodies a body may be sunk into before two such crowded bodies are no longer paired.
 #[pyclass(module = "tumble", name = "World", frozen)]
 pub struct PyWorld {
     // A Mutex rather than PyO3's borrow flag: the engine's World is Send but not Sync
@@ -121,12 +125,21 @@ fn speed_limits(
     })
 }
 
+/// The contact limits given, each defaulting to the engine's.
+fn contact_limits(per_step: Option<i64>, per_body: Option<i64>) -> PyResult<ContactLimits> {
+    let d = ContactLimits::default();
+    Ok(ContactLimits {
+        per_step: per_step.map_or(Ok(d.per_step), |v| count(v, "max_contacts"))?,
+        per_body: per_body.map_or(Ok(d.per_body), |v| count(v, "max_contacts_per_body"))?,
+    })
+}
+
 /// A count such as `substeps`, at least 1.
 fn count(value: i64, field: &str) -> PyResult<u32> {
-    u32::try_from(value)
-        .ok()
-        .filter(|&v| v >= 1)
-        .ok_or_else(|| invalid(field, "must be >= 1"))
+    if value < 1 {
+        return Err(invalid(field, "must be >= 1"));
+    }
+    u32::try_from(value).map_err(|_| invalid(field, format!("must be at most {}", u32::MAX)))
 }
 
 /// Solver settings: `kind` ("soft_step" or "pgs"), `substeps` and `iterations` per step,
@@ -299,7 +312,7 @@ impl PyWorld {
         solver = "soft_step".to_string(), substeps = 4, iterations = 1, contact_hertz = 60.0,
         contact_damping_ratio = 10.0, joint_hertz = 1000.0, joint_damping_ratio = 0.5,
         baumgarte = 0.2, length_unit = 1.0, sleep = true, max_speed = None,
-        max_angular_speed = None))]
+        max_angular_speed = None, max_contacts = None, max_contacts_per_body = None))]
     #[allow(clippy::too_many_arguments)]
     fn py_new(
         gravity: Option<&Bound<'_, PyAny>>,
@@ -316,6 +329,8 @@ impl PyWorld {
         sleep: bool,
         max_speed: Option<f64>,
         max_angular_speed: Option<f64>,
+        max_contacts: Option<i64>,
+        max_contacts_per_body: Option<i64>,
     ) -> PyResult<Self> {
         let settings = PySolverSettings {
             kind: solver,
@@ -334,6 +349,7 @@ impl PyWorld {
             solver: settings.to_core()?,
             sleep,
             limits: speed_limits(max_speed, max_angular_speed, length_unit),
+            contact_limits: contact_limits(max_contacts, max_contacts_per_body)?,
         };
         let world = World::try_new(&def).map_err(engine)?;
         Ok(PyWorld::new_inner(Inner {
@@ -710,6 +726,41 @@ impl PyWorld {
             ..g.world.speed_limits()
         };
         g.world.set_speed_limits(limits).map_err(engine)
+    }
+
+    /// Contact manifolds a step may hold (default 1,048,576, about 4 kB each): a step that
+    /// needs more is undone and raises SimulationError. Assignable (at least 1).
+    #[getter]
+    fn max_contacts(&self) -> PyResult<u32> {
+        Ok(self.lock()?.world.contact_limits().per_step)
+    }
+
+    #[setter]
+    fn set_max_contacts(&self, value: i64) -> PyResult<()> {
+        let mut g = self.lock()?;
+        let limits = ContactLimits {
+            per_step: count(value, "max_contacts")?,
+            ..g.world.contact_limits()
+        };
+        g.world.set_contact_limits(limits).map_err(engine)
+    }
+
+    /// Other dynamic bodies a body may be sunk into before it counts as crowded (default
+    /// 16): two crowded bodies are not paired, so bodies created inside each other keep
+    /// contacts in proportion to their number. Assignable (at least 1).
+    #[getter]
+    fn max_contacts_per_body(&self) -> PyResult<u32> {
+        Ok(self.lock()?.world.contact_limits().per_body)
+    }
+
+    #[setter]
+    fn set_max_contacts_per_body(&self, value: i64) -> PyResult<()> {
+        let mut g = self.lock()?;
+        let limits = ContactLimits {
+            per_body: count(value, "max_contacts_per_body")?,
+            ..g.world.contact_limits()
+        };
+        g.world.set_contact_limits(limits).map_err(engine)
     }
 
     /// Speculative contact distance (m): gaps narrower than this count as contacts.

@@ -352,3 +352,57 @@ def test_bad_input_is_still_a_value_error():
     with pytest.raises(ValueError, match="^dt: must be > 0"):
         world.step(-1.0)
     assert not issubclass(tumble.SimulationError, ValueError)
+
+
+# --- resources in proportion ------------------------------------------------------------
+
+
+def pile(n, **world_kwargs):
+    """n unit boxes created at one point, on a ground."""
+    world = tumble.World(**world_kwargs)
+    world.add_body(tumble.Plane((0, 1, 0), 0.0), kind="static")
+    for _ in range(n):
+        world.add_body(tumble.Box((0.5, 0.5, 0.5)), position=(0, 0.5, 0))
+    return world
+
+
+def test_boxes_created_at_one_point_keep_contacts_in_proportion():
+    """Before: 1,000 boxes at one point took 2 GB (half a million pairs of manifolds)."""
+    n = 400
+    world = pile(n)
+    world.simulate(steps=3, dt=1 / 60)
+    kept = len(world.contacts())
+    # About max_contacts_per_body (16) each, plus four per body before counting starts,
+    # where all n (n - 1) / 2 = 79,800 pairs touch.
+    assert kept <= (16 + 4) * (n + 1) + n, kept
+    assert np.isfinite(world.positions).all()
+
+
+def test_a_step_past_max_contacts_is_undone_and_raises():
+    world = pile(40, max_contacts=100)
+    assert (world.max_contacts, world.max_contacts_per_body) == (100, 16)
+    before = world.state_hash()
+    with pytest.raises(tumble.SimulationError) as caught:
+        world.step(1 / 60)
+    e = caught.value
+    assert str(e) == ("step 1 (t = 0.0166667 s): max_contacts: the step needs more than 100 "
+                      "contact manifolds; raise max_contacts, or start the bodies apart")
+    assert (e.step, e.body, e.quantity) == (1, None, "contacts")
+    assert world.state_hash() == before and world.step_count == 0
+    with pytest.raises(tumble.SimulationError) as caught:
+        world.simulate(steps=5, dt=1 / 60)
+    assert len(caught.value.trajectory) == 1
+    world.max_contacts = 1 << 20
+    world.step(1 / 60)
+    assert world.step_count == 1
+
+
+@pytest.mark.parametrize("field", ["max_contacts", "max_contacts_per_body"])
+@pytest.mark.parametrize("value, rule", [(0, ">= 1"), (-1, ">= 1"), (2**32, "at most 4294967295")])
+def test_contact_limits_are_whole_numbers_from_one(field, value, rule):
+    with pytest.raises(ValueError, match=f"^{field}: must be {rule}$"):
+        tumble.World(**{field: value})
+    world = tumble.World()
+    with pytest.raises(ValueError, match=f"^{field}: must be {rule}$"):
+        setattr(world, field, value)
+    assert (world.max_contacts, world.max_contacts_per_body) == (1 << 20, 16)

@@ -25,6 +25,7 @@ use std::fmt;
 use std::path::Path;
 
 use serde_json::Value;
+use tumble::limits::ContactLimits;
 use tumble::{Integrator, Real, SolverKind, SolverSettings, SpeedLimits, Vec3, World, WorldDef};
 
 pub use body::BODY_KINDS;
@@ -40,7 +41,7 @@ pub use body::check_name;
 
 use reader::{Node, Obj};
 
-const TOP_KEYS: [&str; 20] = [
+const TOP_KEYS: [&str; 22] = [
     "name",
     "description",
     "gravity",
@@ -61,6 +62,8 @@ const TOP_KEYS: [&str; 20] = [
     "sleep",
     "max_speed",
     "max_angular_speed",
+    "max_contacts",
+    "max_contacts_per_body",
 ];
 
 /// The most `substeps` and `iterations` a scene or the command line may ask for.
@@ -178,6 +181,7 @@ fn build(root: &Node<'_>) -> Result<Scene> {
         solver: solver_settings(&obj)?,
         sleep: obj.bool("sleep")?.unwrap_or(true),
         limits: speed_limits(&obj, length_unit)?,
+        contact_limits: contact_limits(&obj)?,
     };
     let dt = obj.real("dt")?.unwrap_or(DEFAULT_DT);
     let duration = obj.real("duration")?.unwrap_or(DEFAULT_DURATION);
@@ -215,6 +219,23 @@ fn speed_limits(obj: &Obj<'_>, length_unit: Real) -> Result<Option<SpeedLimits>>
         max_speed: v.unwrap_or(default.max_speed),
         max_angular_speed: w.unwrap_or(default.max_angular_speed),
     }))
+}
+
+/// `max_contacts` (manifolds per step) and `max_contacts_per_body` (touching pairs a
+/// crowded body keeps), whole numbers from 1, defaulting to the engine's.
+fn contact_limits(obj: &Obj<'_>) -> Result<ContactLimits> {
+    let d = ContactLimits::default();
+    let whole = |key: &str, default: u32| -> Result<u32> {
+        Ok(obj
+            .get(key)
+            .map(|n| n.whole_in(1, u32::MAX.into()))
+            .transpose()?
+            .map_or(default, |v| v as u32))
+    };
+    Ok(ContactLimits {
+        per_body: whole("max_contacts_per_body", d.per_body)?,
+        per_step: whole("max_contacts", d.per_step)?,
+    })
 }
 
 /// The solver called `name`, with the scene format's error for any other name.

@@ -29,6 +29,27 @@ pub enum Error {
     /// beyond the world's limits); the step was undone, the world is as before it.
     #[error("{}", unstable_message(.0))]
     Unstable(Box<Unstable>),
+    /// A step needed more contact manifolds than `ContactLimits::per_step` allows; the step
+    /// was undone, the world is as before it.
+    #[error(
+        "step {} (t = {} s): max_contacts: the step needs more than {} contact manifolds; \
+         raise max_contacts, or start the bodies apart",
+        .0.step,
+        crate::limits::short(.0.time),
+        .0.limit
+    )]
+    TooManyContacts(Box<TooManyContacts>),
+}
+
+/// Which step ran out of contact capacity, and the limit it reached.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TooManyContacts {
+    /// The number of the failed step (the world had taken `step - 1`).
+    pub step: u64,
+    /// Simulated time the failed step would have reached (s).
+    pub time: crate::math::Real,
+    /// The limit, `ContactLimits::per_step`.
+    pub limit: u32,
 }
 
 /// Where and when a step failed: the step number (the first step is 1), its start time,
@@ -96,7 +117,7 @@ impl Error {
                 field: join(field),
                 id,
             },
-            unstable @ Error::Unstable(_) => unstable,
+            failed @ (Error::Unstable(_) | Error::TooManyContacts(_)) => failed,
         }
     }
 
@@ -105,7 +126,13 @@ impl Error {
         match self {
             Error::InvalidField { field, .. } | Error::UnknownBody { field, .. } => field,
             Error::Unstable(_) => "",
+            Error::TooManyContacts(_) => "max_contacts",
         }
+    }
+
+    /// Whether this is a step that failed (and was undone) rather than refused input.
+    pub fn is_step_failure(&self) -> bool {
+        matches!(self, Error::Unstable(_) | Error::TooManyContacts(_))
     }
 }
 

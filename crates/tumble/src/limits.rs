@@ -62,6 +62,52 @@ impl Default for SpeedLimits {
     }
 }
 
+/// How many contacts the engine keeps, so that memory follows the number of bodies and not
+/// how much they overlap. A thousand boxes created at one point touch each other in half a
+/// million pairs; kept whole, their manifolds took 2 GB (about 4 kB a pair: the manifold
+/// and last step's copy, the solver's rows and lanes), and twenty thousand would need 800.
+///
+/// The caps are on bodies *sunk into* each other (interpenetrating by more than the
+/// contact margin, or a quarter of the thinner body's thickness), which touching bodies
+/// are not: a resting contact sinks by the slop. A dynamic body sunk into `per_body` other
+/// dynamic bodies is crowded, and two crowded bodies are not paired; every pair a crowd
+/// keeps is charged to a body not yet crowded, so a crowd keeps contacts in proportion to
+/// its bodies (about `per_body` each), whatever the overlap. A ground under a million
+/// bodies, or a plate on a bed of marbles, keeps every contact: the small bodies are not
+/// sunk into anything, and pairs with static bodies are never shed. In the scenes real
+/// use builds no body comes near its cap; bodies created inside each other shed the
+/// excess pairs, the last ones in pair order, and are still pushed apart by the rest.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ContactLimits {
+    /// Dynamic partners a body may be sunk into before it counts as crowded; default 16.
+    /// The broad phase, whose boxes are looser, allows [`Self::CANDIDATES_PER_CONTACT`]
+    /// times as many, and 16 times as many candidates standing far apart.
+    pub per_body: u32,
+    /// Contact manifolds in a step, over all pairs; a step that would exceed it is undone
+    /// and stops with an error naming the limit. Default 2^20 (1,048,576), about 4 GB.
+    pub per_step: u32,
+}
+
+impl ContactLimits {
+    /// Sunk candidate pairs the broad phase keeps per contact the cache may keep: boxes
+    /// that overlap deeply need not touch (two rotated boxes), so it keeps more.
+    pub const CANDIDATES_PER_CONTACT: u32 = 4;
+}
+
+impl Default for ContactLimits {
+    fn default() -> Self {
+        ContactLimits {
+            per_body: 16,
+            per_step: 1 << 20,
+        }
+    }
+}
+
+/// Most manifolds one pair of bodies keeps (a compound's children against a mesh's
+/// triangles may make one each): the deepest are kept. Four points a manifold, so at most
+/// 1,024 points a pair.
+pub const MAX_MANIFOLDS_PER_PAIR: usize = 256;
+
 /// A number as people write it: `0.683`, `1e15`, `2.5e-7`, never 300 digits.
 pub fn short(x: Real) -> String {
     if x == 0.0 || !x.is_finite() {

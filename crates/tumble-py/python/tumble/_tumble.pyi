@@ -330,6 +330,8 @@ class World:
         sleep: bool = True,
         max_speed: Optional[float] = None,
         max_angular_speed: Optional[float] = None,
+        max_contacts: Optional[int] = None,
+        max_contacts_per_body: Optional[int] = None,
     ) -> None: ...
     @staticmethod
     def from_scene(path: Union[str, PathLike[str]]) -> World:
@@ -559,6 +561,16 @@ class World:
         """The fastest a body may turn (rad/s; default 1e5); assignable."""
     @max_angular_speed.setter
     def max_angular_speed(self, value: float) -> None: ...
+    @property
+    def max_contacts(self) -> int:
+        """Contact manifolds a step may hold (default 1,048,576); a step needing more raises SimulationError."""
+    @max_contacts.setter
+    def max_contacts(self, value: int) -> None: ...
+    @property
+    def max_contacts_per_body(self) -> int:
+        """Other bodies a body may be sunk into before it counts as crowded (default 16)."""
+    @max_contacts_per_body.setter
+    def max_contacts_per_body(self, value: int) -> None: ...
     @property
     def contact_margin(self) -> float: ...
     def diagnostics(self) -> Diagnostics:

@@ -2,13 +2,14 @@
 //! manifold point matched by feature id to last step's, so the solver can start from the
 //! impulses it found then (warm starting).
 
-use crate::collision::broad_phase::BroadPhase;
+use crate::collision::broad_phase::{BroadPhase, Crowding};
 use crate::collision::contact::{Basis, Key, REUSE_DISTANCE};
 pub use crate::collision::contact::{Contact, ContactEvent, ContactEventKind};
 use crate::collision::geometry::{Aabb, Pose};
 use crate::collision::narrow_phase::{collide, Manifold};
 use crate::dynamics::body::{Body, BodyKind};
 use crate::id::BodyId;
+use crate::limits::{ContactLimits, MAX_MANIFOLDS_PER_PAIR};
 use crate::math::{Real, Vec3};
 
 /// Shapes whose pair yields at most one manifold with fixed sub-shapes (0, 0), so that a
@@ -42,15 +43,88 @@ pub(crate) struct ContactCache {
     /// The events of the update before, kept so that a failed step can be undone.
     events_before: Vec<ContactEvent>,
     pairs: Vec<(u32, u32)>,
-    manifolds: Vec<Manifold>,
     /// The touching body pairs of `contacts` and of `previous`, sorted: last update's
     /// list is this one's `before`, so each update sorts only its own.
     touching: Vec<(BodyId, BodyId)>,
     touching_before: Vec<(BodyId, BodyId)>,
+    scratch: PairScratch,
+    /// Per body: dynamic partners it is sunk into in this update (a manifold point deeper
+    /// than `deep`); a body with `ContactLimits::per_body` of them is crowded.
+    degree: Vec<u32>,
+    /// Pairs the last update left out because both bodies were at their cap.
+    crowded: usize,
+    /// Whether the last update stopped at `ContactLimits::per_step` manifolds.
+    overflowed: bool,
+}
+
+/// What the contacts of one pair are computed with, kept to reuse allocations.
+#[derive(Debug, Default)]
+struct PairScratch {
     /// The bodies' tight boxes, computed as pairs need them.
     tight: TightBoxes,
+    manifolds: Vec<Manifold>,
     /// Scratch for broad-phase queries.
     stack: Vec<u32>,
+}
+
+/// What every pair of an update reads.
+struct PairWorld<'a> {
+    bodies: &'a [Body],
+    ids: &'a [BodyId],
+    /// The contact margin (m).
+    margin: Real,
+    /// How many static bodies there are.
+    statics: usize,
+}
+
+/// Appends the contacts of the pair at body indices `(a, b)`: last step's if both are
+/// frozen or their relative pose still holds them, else the narrow phase's, warm-started.
+fn pair_contacts(
+    w: &PairWorld<'_>,
+    old: &Sorted<'_>,
+    (a, b): (usize, usize),
+    broad: &BroadPhase,
+    scratch: &mut PairScratch,
+    contacts: &mut Vec<Contact>,
+) {
+    let (body_a, body_b) = (&w.bodies[a], &w.bodies[b]);
+    // A sleeping island costs nothing: between bodies that cannot have moved, last step's
+    // manifolds still hold.
+    if frozen(body_a) && frozen(body_b) {
+        keep_previous(old, w.ids[a], w.ids[b], a, b, contacts);
+        return;
+    }
+    // The broad phase pairs fat boxes, stretched along each body's motion: as the rain
+    // lands, six pairs in seven are farther apart than the margin. Every routine reports
+    // only points closer than `margin`, and a gap between the tight boxes is a lower bound
+    // of the distance, so a pair whose tight boxes stand more than twice the margin apart
+    // (room to spare over rounding) has no manifold, and is passed over without asking the
+    // narrow phase. Nor can it have a manifold to reuse: that needs a gap under the margin
+    // a few µm ago.
+    let mut tight = |i: usize| *scratch.tight.get_or_insert(i, &w.bodies[i]);
+    if apart(&tight(a), &tight(b), 2.0 * w.margin) {
+        return;
+    }
+    let (pa, pb) = (body_a.pose(), body_b.pose());
+    let poses = (&pa, &pb);
+    if reusable(&body_a.shape)
+        && reusable(&body_b.shape)
+        && reuse_previous(old, (a, b), w.ids, poses, w.margin, contacts)
+    {
+        return;
+    }
+    let manifolds = &mut scratch.manifolds;
+    manifolds.clear();
+    collide(&body_a.shape, &pa, &body_b.shape, &pb, w.margin, manifolds);
+    if w.statics > 1 {
+        for m in manifolds.iter_mut() {
+            let stack = &mut scratch.stack;
+            drop_covered_points(m, (a, b), w.bodies, (broad, stack), w.margin * 0.25);
+        }
+        manifolds.retain(|m| !m.is_empty());
+    }
+    keep_deepest(manifolds, MAX_MANIFOLDS_PER_PAIR);
+    push_new(manifolds, old, (a, b), w.ids, poses, contacts);
 }
 
 /// Each body's tight box at its current pose, computed once per update on first use.
@@ -128,6 +202,56 @@ fn reuse_previous(
     true
 }
 
+/// Contacts per body beyond which an update counts bodies against their caps.
+const ENGAGE: usize = 4;
+
+/// The broad phase's caps for `limits` and the contact margin (m).
+fn crowding(limits: &ContactLimits, margin: Real) -> Crowding {
+    Crowding {
+        sunk: limits
+            .per_body
+            .saturating_mul(ContactLimits::CANDIDATES_PER_CONTACT),
+        any: limits.per_body.saturating_mul(16),
+        depth: margin,
+    }
+}
+
+/// How deep two bodies must interpenetrate to count as sunk into each other: the margin,
+/// or a quarter of the thinner body's thickness where that is less. The same measure as
+/// `Aabb::sunk_into`'s, from the bodies' sizes rather than their boxes'; resting contacts
+/// sink by about the slop (5 mm), below it for any body thicker than 2 cm.
+fn deep(a: &Body, b: &Body, margin: Real) -> Real {
+    margin.min(0.5 * a.ccd_extent.min(b.ccd_extent))
+}
+
+/// Whether a contact has a point deeper than `depth`.
+fn sunk_deeper(c: &Contact, depth: Real) -> bool {
+    c.manifold.points().iter().any(|p| p.separation < -depth)
+}
+
+/// Keeps the `n` deepest manifolds (smallest least separation; ties by position), in their
+/// order, when there are more.
+fn keep_deepest(manifolds: &mut Vec<Manifold>, n: usize) {
+    if manifolds.len() <= n {
+        return;
+    }
+    let depth = |m: &Manifold| {
+        let seps = m.points().iter().map(|p| p.separation);
+        seps.fold(Real::INFINITY, Real::min)
+    };
+    let mut order: Vec<(Real, usize)> = manifolds.iter().map(depth).zip(0..).collect();
+    order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    let mut keep = vec![false; manifolds.len()];
+    for &(_, i) in &order[..n] {
+        keep[i] = true;
+    }
+    let mut i = 0;
+    manifolds.retain(|_| {
+        i += 1;
+        keep[i - 1]
+    });
+}
+
 /// Pushes a contact for each of the pair's freshly computed manifolds, warm-started from
 /// last step's.
 fn push_new(
@@ -159,7 +283,10 @@ impl ContactCache {
     }
 
     /// Recomputes every contact from the broad phase's pairs. Pairs in which neither body
-    /// is dynamic are skipped: nothing could respond to them.
+    /// is dynamic are skipped: nothing could respond to them. So is a pair of two dynamic
+    /// bodies each already sunk into `limits.per_body` others (see `ContactLimits`);
+    /// and the update stops, with [`ContactCache::overflowed`] set, on reaching
+    /// `limits.per_step` manifolds.
     pub fn update(
         &mut self,
         broad: &mut BroadPhase,
@@ -167,7 +294,9 @@ impl ContactCache {
         ids: &[BodyId],
         margin: Real,
         joined: &[(u32, u32)],
+        limits: &ContactLimits,
     ) {
+        broad.set_crowding(crowding(limits, margin));
         broad.pairs(&mut self.pairs);
         let statics = bodies.iter().filter(|b| b.kind == BodyKind::Static).count();
         std::mem::swap(&mut self.contacts, &mut self.previous);
@@ -179,7 +308,17 @@ impl ContactCache {
             hint: std::cell::Cell::new(0),
         };
         self.contacts.clear();
-        self.tight.clear(bodies.len());
+        self.scratch.tight.clear(bodies.len());
+        self.degree.clear();
+        self.degree.resize(bodies.len(), 0);
+        (self.crowded, self.overflowed) = (0, false);
+        let (per_body, per_step) = (limits.per_body, limits.per_step as usize);
+        let world = PairWorld {
+            bodies,
+            ids,
+            margin,
+            statics,
+        };
         for &(a, b) in &self.pairs {
             let (a, b) = (a as usize, b as usize);
             let (Some(body_a), Some(body_b)) = (bodies.get(a), bodies.get(b)) else {
@@ -188,57 +327,49 @@ impl ContactCache {
             if !may_collide(body_a, body_b, (a, b), joined) {
                 continue;
             }
-            // A sleeping island costs nothing: between bodies that cannot have moved, last
-            // step's manifolds still hold.
-            if frozen(body_a) && frozen(body_b) {
-                keep_previous(&old, ids[a], ids[b], a, b, &mut self.contacts);
+            // Bodies are counted once the update holds more than `ENGAGE` contacts per
+            // body, which no scene without crowds reaches: a step then pays one comparison
+            // per pair for the caps, and at most `ENGAGE` per body escape the count.
+            // Pairs with a static or kinematic body are never shed: a ground under a
+            // crowd must hold all of it, and there are at most bodies × statics of them.
+            let counting = self.contacts.len() >= ENGAGE * bodies.len()
+                && body_a.kind == BodyKind::Dynamic
+                && body_b.kind == BodyKind::Dynamic;
+            if counting && self.degree[a] >= per_body && self.degree[b] >= per_body {
+                self.crowded += 1;
                 continue;
             }
-            // The broad phase pairs fat boxes, stretched along each body's motion: as the
-            // rain lands, six pairs in seven are farther apart than the margin. Every
-            // routine reports only points closer than `margin`, and a gap between the
-            // tight boxes is a lower bound of the distance, so a pair whose tight boxes
-            // stand more than twice the margin apart (room to spare over rounding) has no
-            // manifold, and is passed over without asking the narrow phase. Nor can it have
-            // a manifold to reuse: that needs a gap under the margin a few µm ago.
-            let mut tight = |i: usize| *self.tight.get_or_insert(i, &bodies[i]);
-            if apart(&tight(a), &tight(b), 2.0 * margin) {
-                continue;
-            }
-            let (pa, pb) = (body_a.pose(), body_b.pose());
-            let poses = (&pa, &pb);
-            if reusable(&body_a.shape)
-                && reusable(&body_b.shape)
-                && reuse_previous(&old, (a, b), ids, poses, margin, &mut self.contacts)
+            let before = self.contacts.len();
+            let scratch = &mut self.scratch;
+            pair_contacts(&world, &old, (a, b), broad, scratch, &mut self.contacts);
+            let depth = || deep(body_a, body_b, margin);
+            if counting
+                && self.contacts[before..]
+                    .iter()
+                    .any(|c| sunk_deeper(c, depth()))
             {
-                continue;
+                self.degree[a] += 1;
+                self.degree[b] += 1;
             }
-            self.manifolds.clear();
-            collide(
-                &body_a.shape,
-                &body_a.pose(),
-                &body_b.shape,
-                &body_b.pose(),
-                margin,
-                &mut self.manifolds,
-            );
-            if statics > 1 {
-                for m in &mut self.manifolds {
-                    let stack = &mut self.stack;
-                    drop_covered_points(m, (a, b), bodies, (broad, stack), margin * 0.25);
-                }
-                self.manifolds.retain(|m| !m.is_empty());
+            if self.contacts.len() > per_step {
+                self.contacts.truncate(per_step);
+                self.overflowed = true;
+                break;
             }
-            push_new(
-                &self.manifolds,
-                &old,
-                (a, b),
-                ids,
-                poses,
-                &mut self.contacts,
-            );
         }
         self.find_events();
+    }
+
+    /// Pairs the last update left out because both bodies had reached
+    /// `ContactLimits::per_body` touching pairs.
+    pub fn crowded(&self) -> usize {
+        self.crowded
+    }
+
+    /// Whether the last update stopped at `ContactLimits::per_step` manifolds (the step
+    /// that ran it is then undone).
+    pub fn overflowed(&self) -> bool {
+        self.overflowed
     }
 
     /// Sorts `previous` by key into `order` and `keys`. Keys are read once, in list order,

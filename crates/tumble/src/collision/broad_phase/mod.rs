@@ -19,6 +19,14 @@
 //! those proxies alone, then merges. The result equals a brute-force test over all fat
 //! boxes, at the cost of the changed proxies plus one pass over the pair list.
 //!
+//! Crowds are kept in proportion (see [`BroadPhase::set_crowding`]): twenty thousand
+//! boxes created at one point would otherwise store 200 million pairs (3 GB), and a pack
+//! of 5 mm marbles holds five thousand candidates each within the 0.1 m margin. A pair
+//! whose tight boxes are sunk into each other, or far apart, is stored only while one of
+//! its proxies has fewer than a cap of such pairs; a proxy that lost one searches again on
+//! every call, so a far pair left out is found as the boxes close in. Without crowding
+//! the result equals the brute-force test described above.
+//!
 //! Determinism: pairs live in a sorted `Vec`, trees in index pools; no hashing anywhere.
 //!
 //! Layout: this file holds the proxies, their updates and the pair set; `tree.rs` the
@@ -51,6 +59,10 @@ pub const REBUILD_SHARE: Real = 0.25;
 
 /// ... and at least this many: small trees are cheap to update either way.
 pub const REBUILD_MIN: usize = 64;
+
+/// The crowding caps apply once a `pairs()` holds this many pairs per proxy (see
+/// `Crowd::engaged`).
+const ENGAGE: usize = 32;
 
 /// At most this many proxies (2^31 − 1): each tree then has fewer than 2^32 − 1 nodes,
 /// so node and proxy indices fit in `u32` with `u32::MAX` free as "none".
@@ -165,6 +177,8 @@ pub struct BroadPhase {
     moved: Vec<u64>,
     /// The current pairs, sorted.
     pairs: Vec<PairEntry>,
+    /// The caps on crowded proxies' pairs, and what applying them needs.
+    crowd: Crowd,
     /// Scratch for `pairs()`, kept to reuse allocations.
     found: Vec<PairEntry>,
     merged: Vec<PairEntry>,
@@ -186,8 +200,35 @@ impl BroadPhase {
         };
         BroadPhase {
             margin,
+            crowd: Crowd {
+                caps: Crowding::NONE,
+                ..Crowd::default()
+            },
             ..BroadPhase::default()
         }
+    }
+
+    /// Sets the caps that keep crowds in proportion (none by default). A proxy whose tight
+    /// box is sunk into `crowding.sunk` others' (`Aabb::sunk_into` at `crowding.depth`) is
+    /// crowded, and two crowded proxies do not pair; a new pair whose tight boxes are far
+    /// apart (more than twice the depth) is stored only while one of its proxies has fewer
+    /// than `crowding.any` pairs. Each kept pair of a crowd is charged to a proxy not yet
+    /// crowded, so a crowd keeps a number of pairs in proportion to its proxies; a proxy
+    /// that touches many without being sunk into them (a plate on a bed of marbles) keeps
+    /// them all, as does every pair with a static proxy. The caps apply only in a call
+    /// that holds more than 32 pairs per proxy.
+    pub fn set_crowding(&mut self, crowding: Crowding) {
+        self.crowd.caps = Crowding {
+            sunk: crowding.sunk.max(1),
+            any: crowding.any.max(1),
+            depth: crowding.depth,
+        };
+    }
+
+    /// Candidate pairs the last [`BroadPhase::pairs`] left out because both proxies had
+    /// reached the pair cap (0 unless bodies are crowded into each other).
+    pub fn crowded(&self) -> usize {
+        self.crowd.crowded
     }
 
     /// The margin in use (m).
@@ -218,10 +259,12 @@ impl BroadPhase {
                     next_free: NULL,
                 });
                 self.moved.resize(self.proxies.len().div_ceil(64), 0);
+                self.crowd.tight.push(aabb);
                 (self.proxies.len() - 1) as u32
             }
         };
         let node = self.trees[tree_index(kind)].insert(fat, id);
+        self.crowd.tight[id as usize] = aabb;
         let p = &mut self.proxies[id as usize];
         // The moved bit is kept: a reused slot may still be in the move buffer from its
         // removal.
@@ -278,6 +321,7 @@ impl BroadPhase {
             return false;
         };
         let (tree, node) = (tree_index(p.kind), p.node);
+        self.crowd.tight[proxy.0 as usize] = aabb;
         let Some(fresh) = self.needs_reinsert(tree, node, &aabb, displacement) else {
             return false;
         };
@@ -320,6 +364,7 @@ impl BroadPhase {
                 continue;
             };
             let (tree, node) = (tree_index(p.kind), p.node);
+            self.crowd.tight[proxy.0 as usize] = aabb;
             if let Some(fresh) = self.needs_reinsert(tree, node, &aabb, displacement) {
                 pending[tree].push((node, fresh));
                 self.mark_moved(proxy.0);
@@ -355,6 +400,7 @@ impl BroadPhase {
             merged,
             stack,
             pair_stack,
+            crowd,
             ..
         } = self;
         // Every pair whose fat boxes may have changed, or whose proxy is gone, renamed or
@@ -362,6 +408,13 @@ impl BroadPhase {
         if !move_buffer.is_empty() {
             pairs.retain(|e| !bit(moved, e.a) && !bit(moved, e.b));
         }
+        crowd.start(moved.len(), self.count);
+        let kept = &*pairs;
+        let mut admit = |x: u32, y: u32, found: &[PairEntry]| {
+            let fixed = |i: u32| proxies[i as usize].kind == ProxyKind::Static;
+            let exempt = fixed(x) || fixed(y);
+            exempt || crowd.admit(x, y, kept, found)
+        };
         found.clear();
         // When a large share of the moving proxies moved (a burst, see `update_many`), one
         // walk of the moving tree against itself finds their pairs with each other for
@@ -372,7 +425,7 @@ impl BroadPhase {
             trees[moving].self_pairs(pair_stack, |x, y| {
                 let (p, q) = (&proxies[x as usize], &proxies[y as usize]);
                 let fresh = bit(moved, x) || bit(moved, y);
-                if fresh && p.user != q.user && p.filter.allows(&q.filter) {
+                if fresh && p.user != q.user && p.filter.allows(&q.filter) && admit(x, y, found) {
                     found.push(PairEntry::new(x, p.user, y, q.user));
                 }
             });
@@ -389,7 +442,7 @@ impl BroadPhase {
                 if other == id || (bit(moved, other) && other < id) || q.user == p.user {
                     return;
                 }
-                if p.filter.allows(&q.filter) {
+                if p.filter.allows(&q.filter) && admit(id, other, found) {
                     found.push(PairEntry::new(id, p.user, other, q.user));
                 }
             };
@@ -404,18 +457,11 @@ impl BroadPhase {
             moved[(id / 64) as usize] &= !(1 << (id % 64));
         }
         move_buffer.clear();
-        // The kept pairs are sorted; sort the (few) new ones and merge in linear time.
-        if !found.is_empty() {
-            found.sort_unstable();
-            merge(pairs, found, merged);
-            std::mem::swap(pairs, merged);
-        }
-        out.clear();
-        for e in pairs.iter() {
-            let users = e.users();
-            if out.last() != Some(&users) {
-                out.push(users);
-            }
+        publish(pairs, found, merged, out);
+        for i in 0..self.crowd.requery.len() {
+            let id = self.crowd.requery[i];
+            self.crowd.lost[(id / 64) as usize] &= !(1 << (id % 64));
+            self.mark_moved(id);
         }
     }
 
@@ -484,6 +530,146 @@ impl BroadPhase {
 /// [`REBUILD_SHARE`] of them.
 fn is_burst(moved: usize, leaves: usize) -> bool {
     moved >= REBUILD_MIN && moved as Real >= REBUILD_SHARE * leaves as Real
+}
+
+/// Merges the new pairs `found` into the kept ones (both sorted after this), and lists
+/// the user pairs in `out`, each once.
+fn publish(
+    pairs: &mut Vec<PairEntry>,
+    found: &mut [PairEntry],
+    merged: &mut Vec<PairEntry>,
+    out: &mut Vec<(u32, u32)>,
+) {
+    // The kept pairs are sorted; sort the (few) new ones and merge in linear time.
+    if !found.is_empty() {
+        found.sort_unstable();
+        merge(pairs, found, merged);
+        std::mem::swap(pairs, merged);
+    }
+    out.clear();
+    for e in pairs.iter() {
+        let users = e.users();
+        if out.last() != Some(&users) {
+            out.push(users);
+        }
+    }
+}
+
+/// The caps on the pairs of crowded proxies (see [`BroadPhase::set_crowding`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Crowding {
+    /// Sunk pairs that make a proxy crowded: two crowded proxies do not pair.
+    pub sunk: u32,
+    /// Pairs a proxy may have when its partner has as many, for a new pair whose tight
+    /// boxes stand more than twice `depth` apart (a candidate, not a contact).
+    pub any: u32,
+    /// How deep tight boxes must overlap to count as sunk (m; see `Aabb::sunk_into`), and
+    /// half the gap beyond which they are far apart.
+    pub depth: Real,
+}
+
+impl Crowding {
+    /// No caps.
+    pub const NONE: Crowding = Crowding {
+        sunk: u32::MAX,
+        any: u32::MAX,
+        depth: 0.0,
+    };
+
+    fn is_on(&self) -> bool {
+        self.sunk != u32::MAX || self.any != u32::MAX
+    }
+}
+
+/// The caps on crowded proxies' pairs and their bookkeeping.
+#[derive(Debug, Default, Clone)]
+struct Crowd {
+    caps: Crowding,
+    /// Per proxy slot: the tight box last given.
+    tight: Vec<Aabb>,
+    /// Per proxy slot: its sunk pairs and all its pairs, counted while `pairs()` builds
+    /// them.
+    degree: Vec<[u32; 2]>,
+    /// Candidate pairs the last `pairs()` left out because both proxies were at a cap.
+    crowded: usize,
+    /// Whether the caps apply in this `pairs()`: only once it holds more than
+    /// [`ENGAGE`] pairs per proxy, which no scene without crowds reaches (a box in a pile
+    /// has about five candidates), so that they cost nothing there.
+    engaged: bool,
+    /// Live proxies.
+    live: usize,
+    /// Proxies that lost a pair to a cap, each once (bit set `lost`): searched again on
+    /// the next `pairs()`, when their neighbours may have parted.
+    requery: Vec<u32>,
+    lost: Vec<u64>,
+}
+
+impl Crowd {
+    /// Counts each proxy's sunk pairs and all its pairs into `degree` (one per slot).
+    fn count(&mut self, kept: &[PairEntry], found: &[PairEntry]) {
+        self.degree.clear();
+        self.degree.resize(self.tight.len(), [0, 0]);
+        for e in kept.iter().chain(found) {
+            let sunk = self.is_sunk(e.a, e.b);
+            for end in [e.a, e.b] {
+                self.degree[end as usize][0] += sunk as u32;
+                self.degree[end as usize][1] += 1;
+            }
+        }
+    }
+
+    /// Gets ready for a `pairs()` over `words` words of proxy bits and `live` proxies.
+    fn start(&mut self, words: usize, live: usize) {
+        self.crowded = 0;
+        self.requery.clear();
+        self.lost.resize(words, 0);
+        (self.engaged, self.live) = (false, live);
+    }
+
+    /// Whether the tight boxes stand more than twice the depth apart on some axis: the
+    /// contact cache passes such a pair over (see `contact_cache.rs`), so one left out
+    /// loses nothing until the boxes come closer, by which time the proxies have searched
+    /// again. NaN says no.
+    fn is_far(&self, x: u32, y: u32) -> bool {
+        let (a, b) = (&self.tight[x as usize], &self.tight[y as usize]);
+        let gap = (a.min - b.max).max(b.min - a.max).max_element();
+        gap > 2.0 * self.caps.depth
+    }
+
+    fn is_sunk(&self, x: u32, y: u32) -> bool {
+        self.tight[x as usize].sunk_into(&self.tight[y as usize], self.caps.depth)
+    }
+
+    /// Whether the new pair (x, y) fits under the caps, with `kept` and `found` the pairs
+    /// so far: if so it is counted, if not both proxies are noted for searching again.
+    fn admit(&mut self, x: u32, y: u32, kept: &[PairEntry], found: &[PairEntry]) -> bool {
+        if !self.engaged {
+            let many = kept.len() + found.len() >= ENGAGE.saturating_mul(self.live);
+            if !self.caps.is_on() || !many {
+                return true;
+            }
+            self.engaged = true;
+            self.count(kept, found);
+        }
+        let (dx, dy) = (self.degree[x as usize], self.degree[y as usize]);
+        let full = |cap: u32, k: usize| dx[k] >= cap && dy[k] >= cap;
+        if full(self.caps.sunk, 0) || (full(self.caps.any, 1) && self.is_far(x, y)) {
+            self.crowded += 1;
+            for end in [x, y] {
+                if !bit(&self.lost, end) {
+                    self.lost[(end / 64) as usize] |= 1 << (end % 64);
+                    self.requery.push(end);
+                }
+            }
+            return false;
+        }
+        let sunk = self.is_sunk(x, y);
+        for end in [x, y] {
+            self.degree[end as usize][0] += sunk as u32;
+            self.degree[end as usize][1] += 1;
+        }
+        true
+    }
 }
 
 /// Bit `i` of a bit set.

@@ -61,6 +61,21 @@ impl Aabb {
             && self.max.z >= other.min.z
     }
 
+    /// Whether the bodies these boxes bound may be sunk into each other, not just touching:
+    /// the boxes overlap on every axis by more than `depth`, or than a quarter of either
+    /// box's thinnest side where that is less. How deep two convex bodies interpenetrate is at most
+    /// their boxes' least overlap (moving one that far along that axis parts the boxes),
+    /// so a pair this says no to is shallow for sure; resting contacts overlap by the
+    /// slop, a few millimetres. Bodies created inside each other overlap by their size.
+    /// NaN says no.
+    pub fn sunk_into(&self, other: &Aabb, depth: Real) -> bool {
+        let overlap = self.max.min(other.max) - self.min.max(other.min);
+        let thinnest = (self.max - self.min)
+            .min_element()
+            .min((other.max - other.min).min_element());
+        overlap.min_element() > depth.min(0.25 * thinnest)
+    }
+
     /// Whether `other` lies entirely inside.
     pub fn contains(&self, other: &Aabb) -> bool {
         self.min.cmple(other.min).all() && self.max.cmpge(other.max).all()

@@ -22,7 +22,7 @@ use crate::dynamics::body::{Body, BodyKind};
 use crate::dynamics::integrate::IntegratorMemory;
 use crate::dynamics::joint::Joint;
 use crate::dynamics::solver::{SolverBodies, StepTime};
-use crate::error::{Error, Result, Unstable};
+use crate::error::{Error, Result, TooManyContacts, Unstable};
 use crate::limits::{short, SpeedLimits, MAX_COORDINATE};
 use crate::math::{vec3_is_finite, Real, Vec3};
 use crate::pipeline::world::World;
@@ -65,6 +65,20 @@ impl World {
             name: body.name.clone(),
             quantity,
             problem,
+        })))
+    }
+
+    /// Fails the step if its contact update stopped at the step's manifold limit: the
+    /// solver would otherwise run on an arbitrary part of the scene's contacts.
+    pub(super) fn check_contacts(&mut self, time: &StepTime) -> Result<()> {
+        if !self.collision.contacts.overflowed() {
+            return Ok(());
+        }
+        self.undo();
+        Err(Error::TooManyContacts(Box::new(TooManyContacts {
+            step: self.clock.steps + 1,
+            time: time.t + time.dt,
+            limit: self.settings.contacts.per_step,
         })))
     }
 

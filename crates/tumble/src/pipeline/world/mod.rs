@@ -37,7 +37,7 @@ use crate::dynamics::solver::{Scales, SolverSettings};
 use crate::error::{check, Error, Result};
 use crate::handles::Handles;
 use crate::id::{BodyId, ForceId};
-use crate::limits::{SpeedLimits, MAX_ACCELERATION};
+use crate::limits::{ContactLimits, SpeedLimits, MAX_ACCELERATION};
 use crate::math::{Real, Vec3};
 use crate::pipeline::contact_cache::ContactCache;
 use crate::pipeline::diagnostics::{self, Diagnostics};
@@ -73,6 +73,8 @@ pub struct WorldDef {
     /// The speeds no body may reach (see `limits.rs`); `None` takes the defaults for
     /// `length_unit`.
     pub limits: Option<SpeedLimits>,
+    /// How many contacts a body and a step may have (see `limits.rs`).
+    pub contact_limits: ContactLimits,
 }
 
 impl Default for WorldDef {
@@ -84,6 +86,7 @@ impl Default for WorldDef {
             solver: SolverSettings::default(),
             sleep: true,
             limits: None,
+            contact_limits: ContactLimits::default(),
         }
     }
 }
@@ -127,6 +130,7 @@ pub(crate) struct Settings {
     pub solver: SolverSettings,
     pub sleep: bool,
     pub limits: SpeedLimits,
+    pub contacts: ContactLimits,
 }
 
 /// Simulated time (s) and the number of steps taken.
@@ -208,6 +212,7 @@ impl World {
         if let Some(limits) = def.limits {
             world.set_speed_limits(limits)?;
         }
+        world.set_contact_limits(def.contact_limits)?;
         Ok(world)
     }
 
@@ -228,6 +233,10 @@ impl World {
                 solver: def.solver,
                 sleep: def.sleep,
                 limits: def.limits.unwrap_or(SpeedLimits::for_length_unit(unit)),
+                contacts: ContactLimits {
+                    per_body: def.contact_limits.per_body.max(1),
+                    per_step: def.contact_limits.per_step.max(1),
+                },
             },
             clock: Clock::default(),
             bodies: BodyStore::default(),
@@ -269,6 +278,24 @@ impl World {
             self.wake_all();
         }
         self.settings.gravity = gravity;
+        Ok(())
+    }
+
+    /// How many touching pairs a body keeps when crowded, and how many manifolds a step
+    /// may hold (see [`ContactLimits`]).
+    pub fn contact_limits(&self) -> ContactLimits {
+        self.settings.contacts
+    }
+
+    /// Changes the contact limits; refused (changing nothing) if either is 0.
+    pub fn set_contact_limits(&mut self, limits: ContactLimits) -> Result<()> {
+        if limits.per_body == 0 {
+            return Err(Error::invalid("max_contacts_per_body", "must be >= 1"));
+        }
+        if limits.per_step == 0 {
+            return Err(Error::invalid("max_contacts", "must be >= 1"));
+        }
+        self.settings.contacts = limits;
         Ok(())
     }
 
@@ -364,7 +391,8 @@ impl World {
     }
 
     /// Runs the broad and narrow phases on the current state and returns every contact
-    /// manifold; points keep last update's impulses where their feature ids match.
+    /// manifold; points keep last update's impulses where their feature ids match. At most
+    /// [`ContactLimits::per_step`] are returned (a step that needs more fails).
     pub fn update_contacts(&mut self) -> &[Contact] {
         let c = &mut self.collision;
         c.contacts.update(
@@ -373,8 +401,17 @@ impl World {
             self.bodies.ids(),
             self.settings.tolerances.contact_margin,
             &self.joints.joined_pairs,
+            &self.settings.contacts,
         );
         c.contacts.contacts()
+    }
+
+    /// Pairs the last contact update left out because both bodies were crowded past
+    /// [`ContactLimits::per_body`], in the broad phase (candidates) and among touching
+    /// pairs: `(candidates, touching)`. Both 0 unless bodies overlap en masse.
+    pub fn crowded_pairs(&self) -> (usize, usize) {
+        let c = &self.collision;
+        (c.broad_phase.crowded(), c.contacts.crowded())
     }
 
     /// The contacts of the last step (or [`World::update_contacts`]), with the normal and

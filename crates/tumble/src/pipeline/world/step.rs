@@ -5,6 +5,9 @@
 //! stage                reads                               writes
 //! refresh_joint_links  joints, body handles                joints' dense bodies, joined pairs
 //! update_contacts      bodies, broad phase, joined pairs   broad-phase pairs, contact cache
+//! check_contacts       contact cache                       nothing; past the step's contact
+//!                                                          limit, undoes the step and
+//!                                                          returns the error
 //! wake_touched         contacts, joint links               bodies' awake flags
 //! gather               bodies, contacts, joint links       context: solved mask, solver bodies
 //! find_ghosts          bodies, contacts                    context: ghost mask
@@ -74,6 +77,7 @@ impl World {
         self.refresh_joint_links();
         self.keep_undo();
         self.update_contacts();
+        self.check_contacts(&time)?;
         self.wake_touched();
         self.gather();
         self.find_ghosts(&time);
