@@ -67,21 +67,26 @@ impl Default for SpeedLimits {
 /// million pairs; kept whole, their manifolds took 2 GB (about 4 kB a pair: the manifold
 /// and last step's copy, the solver's rows and lanes), and twenty thousand would need 800.
 ///
-/// The caps are on bodies *sunk into* each other (interpenetrating by more than the
-/// contact margin, or a quarter of the thinner body's thickness), which touching bodies
-/// are not: a resting contact sinks by the slop. A dynamic body sunk into `per_body` other
-/// dynamic bodies is crowded, and two crowded bodies are not paired; every pair a crowd
-/// keeps is charged to a body not yet crowded, so a crowd keeps contacts in proportion to
-/// its bodies (about `per_body` each), whatever the overlap. A ground under a million
-/// bodies, or a plate on a bed of marbles, keeps every contact: the small bodies are not
-/// sunk into anything, and pairs with static bodies are never shed. In the scenes real
-/// use builds no body comes near its cap; bodies created inside each other shed the
-/// excess pairs, the last ones in pair order, and are still pushed apart by the rest.
+/// The caps are on crowded bodies. A dynamic body is crowded once it overlaps `per_body`
+/// other dynamic bodies (a manifold point with negative separation), or is sunk into half
+/// as many (interpenetrating by more than the contact margin, or a quarter of the thinner
+/// body's thickness); two crowded bodies are not paired. Every pair a crowd keeps is
+/// charged to a body not yet crowded, so a crowd keeps contacts in proportion to its
+/// bodies (about `per_body / 2` each when all are sunk, at most about `per_body` each),
+/// whatever the overlap. Resting bodies overlap by the slop and sink into nothing: an
+/// equal sphere overlaps at most twelve neighbours, a box in a pile fewer, and a ground
+/// under a million bodies or a plate on a bed of marbles keeps every contact (the small
+/// bodies are not crowded, and pairs with static bodies are never shed). Bodies created
+/// inside each other shed the excess pairs, the last ones in pair order, and are still
+/// pushed apart by the rest. What can be shed that should not: a contact between two
+/// bodies that each overlap 16 others, such as two crates side by side, each on a pallet
+/// of 16 loose blocks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ContactLimits {
-    /// Dynamic partners a body may be sunk into before it counts as crowded; default 16.
-    /// The broad phase, whose boxes are looser, allows [`Self::CANDIDATES_PER_CONTACT`]
-    /// times as many, and 16 times as many candidates standing far apart.
+    /// Dynamic bodies a body may overlap (or half as many it may be sunk into) before it
+    /// counts as crowded; default 16. The broad phase, whose boxes are looser, allows
+    /// [`Self::CANDIDATES_PER_CONTACT`] times as many sunk boxes, and 16 times as many
+    /// candidates standing far apart.
     pub per_body: u32,
     /// Contact manifolds in a step, over all pairs; a step that would exceed it is undone
     /// and stops with an error naming the limit. Default 2^20 (1,048,576), about 4 GB.

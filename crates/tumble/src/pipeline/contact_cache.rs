@@ -48,9 +48,9 @@ pub(crate) struct ContactCache {
     touching: Vec<(BodyId, BodyId)>,
     touching_before: Vec<(BodyId, BodyId)>,
     scratch: PairScratch,
-    /// Per body: dynamic partners it is sunk into in this update (a manifold point deeper
-    /// than `deep`); a body with `ContactLimits::per_body` of them is crowded.
-    degree: Vec<u32>,
+    /// Per body: the dynamic partners it overlaps in this update (a manifold point with
+    /// negative separation), and those it is sunk into (deeper than `deep`).
+    degree: Vec<Degree>,
     /// Pairs the last update left out because both bodies were at their cap.
     crowded: usize,
     /// Whether the last update stopped at `ContactLimits::per_step` manifolds.
@@ -202,6 +202,22 @@ fn reuse_previous(
     true
 }
 
+/// What makes a body crowded: how many dynamic bodies it overlaps, and is sunk into.
+#[derive(Debug, Default, Clone, Copy)]
+struct Degree {
+    overlapping: u32,
+    sunk: u32,
+}
+
+impl Degree {
+    /// Overlapping `per_body` dynamic bodies, or sunk into half as many. Resting bodies
+    /// overlap by the slop and sink into nothing: an equal sphere overlaps at most twelve
+    /// neighbours, a box in a wall or pile fewer.
+    fn crowded(&self, per_body: u32) -> bool {
+        self.overlapping >= per_body || self.sunk >= per_body.div_ceil(2)
+    }
+}
+
 /// Contacts per body beyond which an update counts bodies against their caps.
 const ENGAGE: usize = 4;
 
@@ -283,8 +299,9 @@ impl ContactCache {
     }
 
     /// Recomputes every contact from the broad phase's pairs. Pairs in which neither body
-    /// is dynamic are skipped: nothing could respond to them. So is a pair of two dynamic
-    /// bodies each already sunk into `limits.per_body` others (see `ContactLimits`);
+    /// is dynamic are skipped: nothing could respond to them. So is a pair of two crowded
+    /// dynamic bodies, each already overlapping `limits.per_body` others or sunk into half
+    /// as many (see `ContactLimits`);
     /// and the update stops, with [`ContactCache::overflowed`] set, on reaching
     /// `limits.per_step` manifolds.
     pub fn update(
@@ -310,7 +327,7 @@ impl ContactCache {
         self.contacts.clear();
         self.scratch.tight.clear(bodies.len());
         self.degree.clear();
-        self.degree.resize(bodies.len(), 0);
+        self.degree.resize(bodies.len(), Degree::default());
         (self.crowded, self.overflowed) = (0, false);
         let (per_body, per_step) = (limits.per_body, limits.per_step as usize);
         let world = PairWorld {
@@ -335,21 +352,23 @@ impl ContactCache {
             let counting = self.contacts.len() >= ENGAGE * bodies.len()
                 && body_a.kind == BodyKind::Dynamic
                 && body_b.kind == BodyKind::Dynamic;
-            if counting && self.degree[a] >= per_body && self.degree[b] >= per_body {
+            let crowded = |d: &Degree| d.crowded(per_body);
+            if counting && crowded(&self.degree[a]) && crowded(&self.degree[b]) {
                 self.crowded += 1;
                 continue;
             }
             let before = self.contacts.len();
             let scratch = &mut self.scratch;
             pair_contacts(&world, &old, (a, b), broad, scratch, &mut self.contacts);
-            let depth = || deep(body_a, body_b, margin);
-            if counting
-                && self.contacts[before..]
-                    .iter()
-                    .any(|c| sunk_deeper(c, depth()))
-            {
-                self.degree[a] += 1;
-                self.degree[b] += 1;
+            if counting {
+                let depth = deep(body_a, body_b, margin);
+                let new = &self.contacts[before..];
+                let overlaps = new.iter().any(|c| sunk_deeper(c, 0.0));
+                let sunk = overlaps && new.iter().any(|c| sunk_deeper(c, depth));
+                for i in [a, b] {
+                    self.degree[i].overlapping += overlaps as u32;
+                    self.degree[i].sunk += sunk as u32;
+                }
             }
             if self.contacts.len() > per_step {
                 self.contacts.truncate(per_step);
