@@ -102,7 +102,7 @@ fn pair_contacts(
     // narrow phase. Nor can it have a manifold to reuse: that needs a gap under the margin
     // a few µm ago.
     let mut tight = |i: usize| *scratch.tight.get_or_insert(i, &w.bodies[i]);
-    if apart(&tight(a), &tight(b), 2.0 * w.margin) {
+    if tight(a).apart(&tight(b), 2.0 * w.margin) {
         return;
     }
     let (pa, pb) = (body_a.pose(), body_b.pose());
@@ -142,17 +142,6 @@ impl TightBoxes {
     fn get_or_insert(&mut self, i: usize, body: &Body) -> &Aabb {
         self.boxes[i].get_or_insert_with(|| body.shape.aabb(&body.pose()))
     }
-}
-
-/// Whether the boxes are more than `gap` apart along some axis. NaN compares false: such a
-/// pair is left to the narrow phase.
-fn apart(a: &Aabb, b: &Aabb, gap: Real) -> bool {
-    a.min.x - b.max.x > gap
-        || b.min.x - a.max.x > gap
-        || a.min.y - b.max.y > gap
-        || b.min.y - a.max.y > gap
-        || a.min.z - b.max.z > gap
-        || b.min.z - a.max.z > gap
 }
 
 /// Whether the pair at body indices `(a, b)` needs contacts at all: one of the two must be
@@ -301,9 +290,8 @@ impl ContactCache {
     /// Recomputes every contact from the broad phase's pairs. Pairs in which neither body
     /// is dynamic are skipped: nothing could respond to them. So is a pair of two crowded
     /// dynamic bodies, each already overlapping `limits.per_body` others or sunk into half
-    /// as many (see `ContactLimits`);
-    /// and the update stops, with [`ContactCache::overflowed`] set, on reaching
-    /// `limits.per_step` manifolds.
+    /// as many (see `ContactLimits`); and the update stops, with
+    /// [`ContactCache::overflowed`] set, on reaching `limits.per_step` manifolds.
     pub fn update(
         &mut self,
         broad: &mut BroadPhase,

@@ -454,13 +454,13 @@ impl BroadPhase {
             }
         }
         for &id in move_buffer.iter() {
-            moved[(id / 64) as usize] &= !(1 << (id % 64));
+            set_bit(moved, id, false);
         }
         move_buffer.clear();
         publish(pairs, found, merged, out);
         for i in 0..self.crowd.requery.len() {
             let id = self.crowd.requery[i];
-            self.crowd.lost[(id / 64) as usize] &= !(1 << (id % 64));
+            set_bit(&mut self.crowd.lost, id, false);
             self.mark_moved(id);
         }
     }
@@ -502,7 +502,7 @@ impl BroadPhase {
 
     fn mark_moved(&mut self, id: u32) {
         if !bit(&self.moved, id) {
-            self.moved[(id / 64) as usize] |= 1 << (id % 64);
+            set_bit(&mut self.moved, id, true);
             self.move_buffer.push(id);
         }
     }
@@ -610,11 +610,16 @@ impl Crowd {
         self.degree.clear();
         self.degree.resize(self.tight.len(), [0, 0]);
         for e in kept.iter().chain(found) {
-            let sunk = self.is_sunk(e.a, e.b);
-            for end in [e.a, e.b] {
-                self.degree[end as usize][0] += sunk as u32;
-                self.degree[end as usize][1] += 1;
-            }
+            self.add(e.a, e.b);
+        }
+    }
+
+    /// Counts the pair (x, y) in both proxies' degrees.
+    fn add(&mut self, x: u32, y: u32) {
+        let sunk = self.is_sunk(x, y);
+        for end in [x, y] {
+            self.degree[end as usize][0] += sunk as u32;
+            self.degree[end as usize][1] += 1;
         }
     }
 
@@ -632,8 +637,7 @@ impl Crowd {
     /// again. NaN says no.
     fn is_far(&self, x: u32, y: u32) -> bool {
         let (a, b) = (&self.tight[x as usize], &self.tight[y as usize]);
-        let gap = (a.min - b.max).max(b.min - a.max).max_element();
-        gap > 2.0 * self.caps.depth
+        a.apart(b, 2.0 * self.caps.depth)
     }
 
     fn is_sunk(&self, x: u32, y: u32) -> bool {
@@ -657,18 +661,24 @@ impl Crowd {
             self.crowded += 1;
             for end in [x, y] {
                 if !bit(&self.lost, end) {
-                    self.lost[(end / 64) as usize] |= 1 << (end % 64);
+                    set_bit(&mut self.lost, end, true);
                     self.requery.push(end);
                 }
             }
             return false;
         }
-        let sunk = self.is_sunk(x, y);
-        for end in [x, y] {
-            self.degree[end as usize][0] += sunk as u32;
-            self.degree[end as usize][1] += 1;
-        }
+        self.add(x, y);
         true
+    }
+}
+
+/// Sets or clears bit `i` of a bit set.
+fn set_bit(bits: &mut [u64], i: u32, on: bool) {
+    let (word, mask) = ((i / 64) as usize, 1 << (i % 64));
+    if on {
+        bits[word] |= mask;
+    } else {
+        bits[word] &= !mask;
     }
 }
 

@@ -61,6 +61,18 @@ impl Aabb {
             && self.max.z >= other.min.z
     }
 
+    /// Whether the boxes stand more than `gap` apart along some axis. NaN compares false:
+    /// such a pair is not apart.
+    #[inline]
+    pub fn apart(&self, other: &Aabb, gap: Real) -> bool {
+        self.min.x - other.max.x > gap
+            || other.min.x - self.max.x > gap
+            || self.min.y - other.max.y > gap
+            || other.min.y - self.max.y > gap
+            || self.min.z - other.max.z > gap
+            || other.min.z - self.max.z > gap
+    }
+
     /// Whether the bodies these boxes bound may be sunk into each other, not just touching:
     /// the boxes overlap on every axis by more than `depth`, or than a quarter of either
     /// box's thinnest side where that is less. How deep two convex bodies interpenetrate is at most
