@@ -36,6 +36,7 @@ pub(crate) struct Basis {
 
 impl Basis {
     /// B's pose in A's frame, unnormalised: only compared, never applied.
+    #[inline]
     pub(crate) fn relative(pa: &Pose, pb: &Pose) -> Pose {
         Pose {
             position: pa.inverse_transform_point(pb.position),
@@ -43,6 +44,7 @@ impl Basis {
         }
     }
 
+    #[inline]
     pub(crate) fn of(m: &Manifold, pa: &Pose, pb: &Pose) -> Basis {
         let mut points = [(Vec3::ZERO, Vec3::ZERO); MAX_MANIFOLD_POINTS];
         for (l, p) in points.iter_mut().zip(m.points()) {

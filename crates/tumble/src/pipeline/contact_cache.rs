@@ -616,6 +616,7 @@ fn warm_start(contact: &mut Contact, previous: &Sorted<'_>, poses: (&Pose, &Pose
             .for_each(anchor_here);
         return;
     };
+    contact.manifold.angular_impulse = old.angular_impulse;
     let mid = |a: Vec3, b: Vec3| (a + b) * 0.5;
     for p in contact.manifold.points_mut() {
         let here = mid(p.point_a, p.point_b);

@@ -49,7 +49,9 @@ pub struct ContactPoint {
     pub anchor_b: Vec3,
     /// Whether the anchors hold (false for a new point, or one that slid last step).
     pub anchored: bool,
-    /// Whether friction reached its cone at this point last step.
+    /// Whether friction reached its cone at this point last step, or (for pairs with
+    /// rolling resistance or torsional friction) its anchors had rolled away: either way
+    /// it is re-anchored where it now touches.
     pub sliding: bool,
 }
 
@@ -65,6 +67,10 @@ pub struct Manifold {
     pub subshape_a: u32,
     /// Compound child or triangle index on B.
     pub subshape_b: u32,
+    /// The solver's accumulated angular impulse of the last substep on B (−it on A), world
+    /// frame (N·m·s): rolling resistance about the tangents, torsional friction about the
+    /// normal. Zero unless a body of the pair has either; kept to warm start the next step.
+    pub angular_impulse: Vec3,
     points: [ContactPoint; MAX_MANIFOLD_POINTS],
     count: u8,
 }
@@ -135,6 +141,7 @@ impl Manifold {
     pub fn swapped(&self) -> Manifold {
         let mut m = *self;
         m.normal = -self.normal;
+        m.angular_impulse = -self.angular_impulse;
         std::mem::swap(&mut m.subshape_a, &mut m.subshape_b);
         for p in m.points_mut() {
             std::mem::swap(&mut p.point_a, &mut p.point_b);
