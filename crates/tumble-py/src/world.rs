@@ -391,13 +391,16 @@ impl PyWorld {
     /// mass and `angular_velocity` (rad/s), world frame; `kind` "dynamic", "kinematic" or
     /// "static"; `inertia` as 3 principal moments or a 3×3 matrix (kg·m², body axes) and
     /// `center_of_mass` (m, body frame) override the shape's; `planar` confines the body
-    /// to the xy plane; `friction`, `restitution`, `collision_group`/`collision_mask`
+    /// to the xy plane; `friction`, `restitution`, `rolling_resistance` (dimensionless:
+    /// rolling torque at most μ_r r N) and `torsional_friction` (m: spinning torque at most
+    /// μ_t N; a pair uses the larger of each), `collision_group`/`collision_mask`
     /// (32-bit layer sets) and `bullet` (continuous collision against every body).
     #[pyo3(signature = (shape, *, mass = None, density = None, position = None,
         orientation = None, velocity = None, angular_velocity = None,
         kind = "dynamic".to_string(), name = None, planar = false, inertia = None,
-        center_of_mass = None, friction = 0.6, restitution = 0.0, collision_group = 1,
-        collision_mask = 0xFFFF_FFFF, bullet = false))]
+        center_of_mass = None, friction = 0.6, restitution = 0.0, rolling_resistance = 0.0,
+        torsional_friction = 0.0, collision_group = 1, collision_mask = 0xFFFF_FFFF,
+        bullet = false))]
     #[allow(clippy::too_many_arguments)]
     fn add_body<'py>(
         slf: &Bound<'py, Self>,
@@ -415,6 +418,8 @@ impl PyWorld {
         center_of_mass: Option<&Bound<'py, PyAny>>,
         friction: f64,
         restitution: f64,
+        rolling_resistance: f64,
+        torsional_friction: f64,
         collision_group: i64,
         collision_mask: i64,
         bullet: bool,
@@ -455,6 +460,8 @@ impl PyWorld {
             collision_mask: layer_bits(collision_mask, "collision_mask")?,
             friction: real(friction),
             restitution: real(restitution),
+            rolling_resistance: real(rolling_resistance),
+            torsional_friction: real(torsional_friction),
             bullet,
         };
         let id = slf

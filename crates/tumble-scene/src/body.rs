@@ -5,7 +5,7 @@ use tumble::{BodyDef, BodyKind, InertiaSpec, MassSpec, Mat3, Quat, Shape, Vec3};
 use crate::error::{printable, Result};
 use crate::reader::{Node, Obj};
 
-const BODY_KEYS: [&str; 18] = [
+const BODY_KEYS: [&str; 20] = [
     "name",
     "kind",
     "shape",
@@ -22,6 +22,8 @@ const BODY_KEYS: [&str; 18] = [
     "collision_mask",
     "friction",
     "restitution",
+    "rolling_resistance",
+    "torsional_friction",
     "bullet",
     "color",
 ];
@@ -68,6 +70,8 @@ pub(crate) fn body(node: &Node<'_>) -> Result<(BodyDef, Shape)> {
         collision_mask: bits(&obj, "collision_mask")?.unwrap_or(u32::MAX),
         friction: obj.real("friction")?.unwrap_or(BodyDef::default().friction),
         restitution: obj.real("restitution")?.unwrap_or(0.0),
+        rolling_resistance: obj.real("rolling_resistance")?.unwrap_or(0.0),
+        torsional_friction: obj.real("torsional_friction")?.unwrap_or(0.0),
         bullet: obj.bool("bullet")?.unwrap_or(false),
     };
     let shape = crate::shape::shape(&obj.required("shape")?)?;

@@ -92,6 +92,18 @@ pub struct BodyDef {
     pub friction: Real,
     /// Coefficient of restitution in [0, 1]; a pair uses the larger. Default 0.
     pub restitution: Real,
+    /// Rolling resistance coefficient (dimensionless, as Box2D v3's `rollingResistance`
+    /// and the engineering C_rr): a contact resists the two bodies' relative rolling with
+    /// a torque of at most μ_r r N, N its normal force and r its rolling radius (the
+    /// distance from a moving body's centre of mass to the contact plane, the smaller of
+    /// two: a ball's radius). A pair uses max(μ_a, μ_b). A ball rolling on a plane then
+    /// slows at (5/7) μ_r g. Default 0: none, at no cost.
+    pub rolling_resistance: Real,
+    /// Torsional (spinning) friction (m, as MuJoCo's torsional coefficient): a contact
+    /// resists the two bodies' relative spin about its normal with a torque of at most
+    /// μ_t N. A flat patch of radius a pressed evenly, with friction μ, has μ_t = (2/3) μ a.
+    /// A pair uses max(μ_a, μ_b). Default 0: none, at no cost.
+    pub torsional_friction: Real,
     /// Continuous collision against every body, not only static ones, for fast projectiles.
     pub bullet: bool,
 }
@@ -113,6 +125,8 @@ impl Default for BodyDef {
             collision_mask: u32::MAX,
             friction: 0.6,
             restitution: 0.0,
+            rolling_resistance: 0.0,
+            torsional_friction: 0.0,
             bullet: false,
         }
     }
@@ -128,6 +142,8 @@ pub struct Body {
     pub(crate) filter: crate::collision::broad_phase::Filter,
     pub(crate) friction: Real,
     pub(crate) restitution: Real,
+    pub(crate) rolling_resistance: Real,
+    pub(crate) torsional_friction: Real,
     pub(crate) bullet: bool,
     /// Half the body's thinnest extent: moving farther in a step makes it a CCD candidate.
     pub(crate) ccd_extent: Real,
@@ -188,6 +204,8 @@ impl Body {
             },
             friction: def.friction,
             restitution: def.restitution,
+            rolling_resistance: def.rolling_resistance,
+            torsional_friction: def.torsional_friction,
             bullet: def.bullet,
             ccd_extent: 0.0,
             awake: true,
@@ -248,6 +266,14 @@ impl Body {
     /// Coefficient of restitution.
     pub fn restitution(&self) -> Real {
         self.restitution
+    }
+    /// Rolling resistance coefficient (dimensionless; see [`BodyDef::rolling_resistance`]).
+    pub fn rolling_resistance(&self) -> Real {
+        self.rolling_resistance
+    }
+    /// Torsional friction (m; see [`BodyDef::torsional_friction`]).
+    pub fn torsional_friction(&self) -> Real {
+        self.torsional_friction
     }
     /// Collision layers (group) and the layers it collides with (mask).
     pub fn collision_filter(&self) -> (u32, u32) {
@@ -377,6 +403,13 @@ fn validate_def(def: &BodyDef) -> Result<()> {
     check::non_negative("restitution", def.restitution)?;
     if def.restitution > 1.0 {
         return Err(Error::invalid("restitution", "must be <= 1"));
+    }
+    for (field, x) in [
+        ("rolling_resistance", def.rolling_resistance),
+        ("torsional_friction", def.torsional_friction),
+    ] {
+        // Finite, within the magnitude limit, and not negative.
+        check::non_negative(field, x)?;
     }
     match def.mass {
         MassSpec::Density(d) => check::positive("density", d),

@@ -91,6 +91,9 @@ pub(crate) struct BodySim {
     pub friction: Real,
     pub restitution: Real,
     pub local_center: Vec3,
+    /// Rolling resistance (dimensionless) and torsional friction (m); see `BodyDef`.
+    pub rolling_resistance: Real,
+    pub torsional_friction: Real,
 }
 
 impl BodySim {
@@ -131,6 +134,8 @@ impl BodySim {
             friction: body.friction,
             restitution: body.restitution,
             local_center: body.local_center,
+            rolling_resistance: body.rolling_resistance,
+            torsional_friction: body.torsional_friction,
         };
         let state = BodyState {
             v: m.v,

@@ -1,14 +1,17 @@
 //! Contact constraints: non-penetration along the normal with soft or Baumgarte position
-//! correction, Coulomb friction with a circular cone (isotropic), and restitution.
+//! correction, Coulomb friction with a circular cone (isotropic), restitution, and for
+//! pairs that have them rolling resistance and torsional friction (`super::angular`).
 //!
 //! This module prepares a manifold's rows (`super::rows` gives their mathematics) and
 //! runs them one manifold at a time. The solve, relax and warm-start passes run most
 //! manifolds eight at a time in lanes (`super::contact_wide`), through the very same row
-//! code; the scalar passes here serve the rest, and the end-of-step bounces
+//! code; the scalar passes here serve the rest (among them every manifold with angular
+//! rows, which the lanes do not carry), and the end-of-step bounces
 //! (`super::restitution`) and the reports read the points here.
 
 use std::borrow::{Borrow, BorrowMut};
 
+use super::angular::AngularRows;
 use super::body::{BodySim, BodyState};
 use super::contact_wide::ContactLanes;
 use super::rows::{self, Frame, Masks, Motion, Pair, Pass, Sums};
@@ -119,12 +122,14 @@ impl BorrowMut<Sums> for PointCold {
 
 /// Every contact point of the step, manifold by manifold, hot and cold parts in step;
 /// `lanes` holds the wide passes' copy of the grouped manifolds' points, whose impulses
-/// are the current ones until [`Points::save_lanes`] copies them back.
+/// are the current ones until [`Points::save_lanes`] copies them back; `angular` the
+/// rolling and twist rows of the manifolds that have them (see `super::angular`).
 #[derive(Debug, Default)]
 pub(crate) struct Points {
     pub hot: Vec<Point>,
     pub cold: Vec<PointCold>,
     pub lanes: ContactLanes,
+    pub angular: Vec<AngularRows>,
 }
 
 impl Points {
@@ -132,12 +137,15 @@ impl Points {
         self.hot.clear();
         self.cold.clear();
         self.lanes.clear();
+        self.angular.clear();
     }
 
     /// Groups the constraints (in the solver's order) for the wide passes; no group
     /// spans `split`, where the passes of the heavy islands start.
     pub fn group_lanes(&mut self, constraints: &[ContactConstraint], split: usize) {
-        self.lanes.build(constraints, split, &self.hot, &self.cold);
+        let angular = !self.angular.is_empty();
+        self.lanes
+            .build(constraints, (split, angular), &self.hot, &self.cold);
     }
 
     /// Brings the grouped points' impulses and totals back from the lanes.
@@ -153,8 +161,13 @@ pub(crate) struct PairData {
     pub bodies: (usize, usize),
     /// The pair's friction and restitution.
     pub material: (Real, Real),
+    /// The pair's rolling resistance and torsional friction (`super::angular::combine`).
+    pub angular: (Real, Real),
     /// The bodies' frames at the start of the step (for the friction anchors).
     pub poses: (Pose, Pose),
+    /// The contact slop (m): friction anchors farther than this from their point have
+    /// rolled away (pairs with angular rows, see `super::angular`).
+    pub slop: Real,
 }
 
 /// One manifold as the solver works on it; its points are `count` entries of [`Points`]
@@ -175,6 +188,8 @@ pub(crate) struct ContactConstraint {
     /// Graph colour (see `Solver::colour_order`): constraints of one colour below 63
     /// share no moving body.
     colour: u32,
+    /// The manifold's rolling and twist rows in `Points::angular`, if its pair has either.
+    angular: Option<u32>,
 }
 
 /// How hard anchors pull, as a fraction of the contact spring's rate. At the full rate a
@@ -182,6 +197,25 @@ pub(crate) struct ContactConstraint {
 /// within millimetres and the 385-box pyramid still holds to 0.05 mm over 10 s (2 mm
 /// without anchors).
 pub(super) const ANCHOR_STIFFNESS: Real = 0.5;
+
+/// The rolling and twist rows of manifold `m`, appended to `points`, if its pair has
+/// either coefficient; their index.
+fn angular_rows(
+    m: &crate::collision::narrow_phase::Manifold,
+    pair: &PairData,
+    bodies: (&BodySim, &BodySim),
+    tangents: [Vec3; 2],
+    points: &mut Points,
+) -> Option<u32> {
+    let (rolling, twist) = pair.angular;
+    if rolling > 0.0 || twist > 0.0 {
+        let rows = AngularRows::new(m, bodies, tangents, pair.angular);
+        points.angular.push(rows);
+        Some(points.angular.len() as u32 - 1)
+    } else {
+        None
+    }
+}
 
 /// The two bodies' states, mutably; `a != b` always (a body never touches itself).
 pub(super) fn pair(
@@ -205,7 +239,6 @@ impl ContactConstraint {
     ) -> Self {
         let (a, b) = pair.bodies;
         let (friction, restitution) = pair.material;
-        let poses = pair.poses;
         let m = &contact.manifold;
         let (sa, sb) = (&sims[a], &sims[b]);
         let normal = m.normal;
@@ -228,8 +261,29 @@ impl ContactConstraint {
             first: points.hot.len(),
             count: m.len(),
             colour,
+            angular: angular_rows(m, pair, (sa, sb), tangents, points),
         };
-        for mp in m.points() {
+        c.add_points(contact, pair, sims, states, points);
+        if let Some(k) = c.angular {
+            let hot = &mut points.hot[c.range()];
+            points.angular[k as usize].renew_rolled_anchors(m, pair, hot);
+        }
+        c
+    }
+
+    /// Appends the manifold's points to `points`: anchors, rows, warm starts.
+    fn add_points(
+        &self,
+        contact: &Contact,
+        pair: &PairData,
+        sims: &[BodySim],
+        states: &[BodyState],
+        points: &mut Points,
+    ) {
+        let (a, b) = pair.bodies;
+        let (sa, sb, poses) = (&sims[a], &sims[b], pair.poses);
+        let (normal, tangents) = (self.frame.normal, self.frame.tangents);
+        for mp in contact.manifold.points() {
             let mid = (mp.point_a + mp.point_b) * 0.5;
             let (ra, rb) = (mid - sa.x, mid - sb.x);
             let normal_row = Row::new(normal, ra, rb, sa, sb);
@@ -268,7 +322,11 @@ impl ContactConstraint {
                 ..PointCold::default()
             });
         }
-        c
+    }
+
+    /// Whether the manifold has rolling or twist rows (and so stays on the scalar path).
+    pub fn has_angular(&self) -> bool {
+        self.angular.is_some()
     }
 
     /// Dense indices of the two bodies.
@@ -321,12 +379,15 @@ impl ContactConstraint {
     }
 
     /// Applies the accumulated impulses again (each substep, as Box2D v3 does).
-    pub fn warm_start(&self, points: &[Point], states: &mut [BodyState]) {
+    pub fn warm_start(&self, points: &Points, states: &mut [BodyState]) {
         let Some((a, b)) = pair(states, self.a, self.b) else {
             return;
         };
         let mut s = Pair::load(a, b);
-        rows::warm_start(&self.frame, &points[self.range()], self.masks(), &mut s);
+        rows::warm_start(&self.frame, &points.hot[self.range()], self.masks(), &mut s);
+        if let Some(k) = self.angular {
+            points.angular[k as usize].warm_start(&mut s);
+        }
         s.store(self.moves, a, b);
     }
 
@@ -343,6 +404,9 @@ impl ContactConstraint {
             rows::solve::<Real, _, true>(f, (hot, cold), masks, (&mut s, &motion), pass);
         } else {
             rows::solve::<Real, _, false>(f, (hot, cold), masks, (&mut s, &motion), pass);
+        }
+        if let Some(k) = self.angular {
+            points.angular[k as usize].solve(hot, &mut s);
         }
         s.store(self.moves, a, b);
     }
@@ -372,6 +436,10 @@ impl ContactConstraint {
             mp.sliding = p.normal_impulse == 0.0 || friction >= 0.999 * cone;
             let t = self.frame.tangents;
             mp.total_tangent_impulse = t[0] * c.total_tangent[0] + t[1] * c.total_tangent[1];
+        }
+        match self.angular {
+            Some(k) => points.angular[k as usize].store(&mut contact.manifold),
+            None => contact.manifold.angular_impulse = Vec3::ZERO,
         }
     }
 }

@@ -83,11 +83,12 @@ impl ContactLanes {
 
     /// Groups `constraints` (in the solver's order) and copies their points into slots;
     /// groups stay on one side of `split` (the passes of the heavy islands start there,
-    /// see `Solver::passes`). No groups in scalar mode.
+    /// see `Solver::passes`); `angular` says whether any constraint has angular rows,
+    /// which stay scalar. No groups in scalar mode.
     pub fn build(
         &mut self,
         constraints: &[ContactConstraint],
-        split: usize,
+        (split, angular): (usize, bool),
         hot: &[Point],
         cold: &[PointCold],
     ) {
@@ -103,14 +104,14 @@ impl ContactLanes {
                     .iter()
                     .position(|c| c.colour() != colour)
                     .map_or(part.end, |n| start + n);
-                if colour < 63 {
-                    for first in (start..end).step_by(LANES) {
-                        let lanes = (end - first).min(LANES);
-                        if lanes >= MIN_LANES {
-                            let cs = &constraints[first..first + lanes];
-                            self.push_group(cs, first, hot, cold);
-                        }
+                let mut first = start;
+                while colour < 63 && first < end {
+                    let lanes = group_size(&constraints[first..end], angular);
+                    if lanes >= MIN_LANES {
+                        let cs = &constraints[first..first + lanes];
+                        self.push_group(cs, first, hot, cold);
                     }
+                    first += lanes.max(1);
                 }
                 start = end;
             }
@@ -318,6 +319,23 @@ impl Group {
     }
 }
 
+/// How many of `run` (constraints of one colour, in order) the next group takes: up to
+/// [`LANES`], ending before the first manifold with angular rows (rolling resistance,
+/// torsional friction), which the lanes do not carry; 0 if `run` starts with one, which
+/// then stays on the scalar path. Without angular rows in the step (`angular` false) the
+/// groups are the run's consecutive eights, as they always were.
+#[inline]
+fn group_size(run: &[ContactConstraint], angular: bool) -> usize {
+    let most = run.len().min(LANES);
+    if !angular {
+        return most;
+    }
+    run[..most]
+        .iter()
+        .position(ContactConstraint::has_angular)
+        .unwrap_or(most)
+}
+
 /// The columns of each lane's ΔR.
 #[inline(always)]
 fn rotation(states: &[BodyState], index: &[usize; LANES]) -> [Lanes3; 3] {
@@ -361,14 +379,14 @@ fn warm_start_lanes(constraints: &[ContactConstraint], points: &Points, states: 
     let mut next = 0;
     for g in &lanes.groups {
         for c in &constraints[next..g.first] {
-            c.warm_start(&points.hot, states);
+            c.warm_start(points, states);
         }
         let span = g.slot0..g.slot0 + g.slots;
         g.warm_start(&lanes.slots[span.clone()], &lanes.masks[span], states);
         next = g.first + g.lanes;
     }
     for c in &constraints[next..] {
-        c.warm_start(&points.hot, states);
+        c.warm_start(points, states);
     }
 }
 
@@ -505,6 +523,27 @@ mod tests {
         w
     }
 
+    /// The pile with rolling resistance on every fourth body and torsional friction on
+    /// every third: manifolds with angular rows (scalar only) among the lane groups'.
+    fn rolling_pile() -> World {
+        let w = pile();
+        let mut out = world_on_ground();
+        for (i, (_, b)) in w.bodies().enumerate().skip(1) {
+            let def = BodyDef {
+                position: b.position(),
+                orientation: b.orientation(),
+                restitution: b.restitution(),
+                friction: b.friction(),
+                mass: MassSpec::Mass(b.mass()),
+                rolling_resistance: if i % 4 == 0 { 0.05 } else { 0.0 },
+                torsional_friction: if i % 3 == 0 { 0.01 } else { 0.0 },
+                ..Default::default()
+            };
+            out.create_body(&def, b.shape().clone()).unwrap();
+        }
+        out
+    }
+
     /// Lone spheres and heavy pairs on the ground: the ordinary contacts are all of colour
     /// 0, and so are the first of the heavy islands' contacts after them, so a group that
     /// ignored the boundary would run heavy contacts in the ordinary passes.
@@ -538,7 +577,7 @@ mod tests {
         // The lane passes perform each lane's scalar operations in the scalar order
         // (module docs): trajectories and reported impulses must agree to the bit,
         // whichever kernels this CPU runs.
-        for scene in [pile, row] {
+        for scene in [pile, row, rolling_pile] {
             let scalar = run(LaneMode::Scalar, scene);
             assert_eq!(run(LaneMode::Portable, scene), scalar);
             assert_eq!(run(LaneMode::Avx2, scene), scalar);

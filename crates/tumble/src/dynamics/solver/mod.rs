@@ -16,6 +16,7 @@
 //! This is Box2D v3's soft step (Catto 2024) carried to 3D, with angular momentum as the
 //! integrated rotational state so that constrained bodies tumble as correctly as free ones.
 
+mod angular;
 mod body;
 mod contact;
 mod contact_wide;
@@ -105,7 +106,7 @@ impl Solver {
             input.joints,
             input.joint_bodies,
         );
-        self.prepare(bodies, contacts, input.ghosts);
+        self.prepare(bodies, contacts, input.ghosts, input.scales.linear_slop);
         self.prepare_joints(bodies, world_bodies, input.joints, input.joint_bodies);
         let passes = joint_passes(input.settings, time);
         let any_split = self.split_kicks(bodies);
@@ -235,7 +236,15 @@ impl Solver {
             mass_ratio::heavy_islands(&bodies.sims, touching.chain(joined)).unwrap_or_default();
     }
 
-    fn prepare(&mut self, bodies: &SolverBodies, contacts: &[Contact], ghosts: &[bool]) {
+    /// The step's contact constraints, in colour order, and their lane groups; `slop` (m)
+    /// tells rolled friction anchors (see `angular::AngularRows::renew_rolled_anchors`).
+    fn prepare(
+        &mut self,
+        bodies: &SolverBodies,
+        contacts: &[Contact],
+        ghosts: &[bool],
+        slop: Real,
+    ) {
         self.constraints.clear();
         self.points.clear();
         let order = self.colour_order(&bodies.sims, contacts, ghosts);
@@ -253,7 +262,9 @@ impl Solver {
             let pair = PairData {
                 bodies: (a, b),
                 material: (friction, restitution),
+                angular: angular::combine(sa, sb),
                 poses: (pose(a), pose(b)),
+                slop,
             };
             self.constraints.push(ContactConstraint::prepare(
                 (i, colour),
