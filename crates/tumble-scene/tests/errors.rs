@@ -46,7 +46,8 @@ fn misspelt_keys_are_refused_with_the_allowed_ones() {
         error(&one_body(r#""velocty": [1, 0, 0]"#)),
         "bodies[0].velocty: unknown key (expected one of: name, kind, shape, mass, density, \
          inertia, center_of_mass, position, orientation, velocity, angular_velocity, planar, \
-         collision_group, collision_mask, friction, restitution, bullet, color)"
+         collision_group, collision_mask, friction, restitution, rolling_resistance, \
+         torsional_friction, bullet, color)"
     );
     assert_eq!(
         error(&with_forces(
@@ -383,5 +384,33 @@ fn solver_passes_state_one_rule_for_every_bad_count() {
             );
         }
         assert!(load_str(&format!(r#"{{"{key}": 1000000}}"#)).is_ok());
+    }
+}
+
+#[test]
+fn rolling_resistance_and_torsional_friction_are_checked_with_their_paths() {
+    for key in ["rolling_resistance", "torsional_friction"] {
+        assert_eq!(
+            error(&one_body(&format!(r#""{key}": -0.1"#))),
+            format!("bodies[0].{key}: must be >= 0")
+        );
+        assert_eq!(
+            error(&one_body(&format!(r#""{key}": 1e20"#))),
+            format!("bodies[0].{key}: must be at most 1e15 in magnitude")
+        );
+        assert_eq!(
+            error(&one_body(&format!(r#""{key}": 1e400"#))),
+            format!("bodies[0].{key}: must be a finite number")
+        );
+        assert_eq!(
+            error(&one_body(&format!(r#""{key}": "0.1""#))),
+            format!("bodies[0].{key}: expected a number")
+        );
+        // The second body's, to show the index.
+        let two = format!(
+            r#"{{"bodies": [{{"shape": {{"type": "sphere", "radius": 0.1}}}},
+                            {{"shape": {{"type": "sphere", "radius": 0.1}}, "{key}": -1}}]}}"#
+        );
+        assert_eq!(error(&two), format!("bodies[1].{key}: must be >= 0"));
     }
 }

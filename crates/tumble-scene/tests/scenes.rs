@@ -325,3 +325,48 @@ fn the_documentation_example_loads() {
     assert_eq!(scene.body_names, ["ball"]);
     assert_eq!(scene.world.forces().count(), 3);
 }
+
+#[test]
+fn rolling_resistance_and_torsional_friction_load_and_default_to_zero() {
+    let scene = load(
+        r#"{"bodies": [
+        {"shape": {"type": "sphere", "radius": 0.1},
+         "rolling_resistance": 0.05, "torsional_friction": 0.002},
+        {"shape": {"type": "sphere", "radius": 0.1}}]}"#,
+    );
+    let bodies: Vec<_> = scene.world.bodies().map(|(_, b)| b).collect();
+    assert_eq!(
+        (
+            bodies[0].rolling_resistance(),
+            bodies[0].torsional_friction()
+        ),
+        (0.05, 0.002)
+    );
+    assert_eq!(
+        (
+            bodies[1].rolling_resistance(),
+            bodies[1].torsional_friction()
+        ),
+        (0.0, 0.0)
+    );
+}
+
+#[test]
+fn every_body_key_is_in_the_documented_table() {
+    // The reader lists its keys when refusing an unknown one; the Bodies table of
+    // docs/scene-format.md must have a row for each.
+    let err = load_str(r#"{"bodies": [{"shape": {"type": "sphere", "radius": 1}, "x": 1}]}"#)
+        .expect_err("an unknown key");
+    let keys = err.reason.split("expected one of: ").nth(1).unwrap();
+    let keys = keys.trim_end_matches(')').split(", ");
+    let doc = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/scene-format.md");
+    let doc = std::fs::read_to_string(doc).unwrap();
+    let table = doc.split("## Bodies").nth(1).unwrap();
+    let table = table.split("\n\n").nth(1).unwrap();
+    for key in keys {
+        assert!(
+            table.lines().any(|l| l.starts_with(&format!("| `{key}`"))),
+            "{key} has no row in the Bodies table"
+        );
+    }
+}
