@@ -197,6 +197,18 @@ impl PyBody {
         self.read(|b| wide(b.restitution()))
     }
 
+    /// Rolling resistance coefficient (dimensionless): rolling torque at most μ_r r N.
+    #[getter]
+    fn rolling_resistance(&self) -> PyResult<f64> {
+        self.read(|b| wide(b.rolling_resistance()))
+    }
+
+    /// Torsional friction (m): spinning torque about the contact normal at most μ_t N.
+    #[getter]
+    fn torsional_friction(&self) -> PyResult<f64> {
+        self.read(|b| wide(b.torsional_friction()))
+    }
+
     /// Applies an impulse (N·s, world frame) at a world point (m; default the centre of
     /// mass): Δp = J, ΔL = (point − x) × J. Ignored for static and kinematic bodies.
     #[pyo3(signature = (impulse, point = None))]

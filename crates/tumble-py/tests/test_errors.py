@@ -76,6 +76,8 @@ def test_construction_errors(make, error, message):
         (dict(shape=tumble.Sphere(1), inertia=[[1, 0, 0], [0, 1, 0]]), ValueError, "inertia: "),
         (dict(shape=tumble.Sphere(1), friction=-0.1), ValueError, "friction: "),
         (dict(shape=tumble.Sphere(1), restitution=2.0), ValueError, "restitution: must be <= 1"),
+        (dict(shape=tumble.Sphere(1), rolling_resistance=-0.1), ValueError, "rolling_resistance: must be >= 0"),
+        (dict(shape=tumble.Sphere(1), torsional_friction=float("nan")), ValueError, "torsional_friction: must be a finite number"),
         (dict(shape=tumble.Sphere(1), collision_group=-1), ValueError, "collision_group: "),
         (dict(shape=tumble.Sphere(1), collision_mask=2**40), ValueError, "collision_mask: "),
     ],

@@ -107,6 +107,37 @@ def test_resting_stack_carries_its_weight():
     assert push == pytest.approx(3 * G * dt, rel=0.02)
 
 
+
+def test_rolling_resistance_and_torsional_friction_closed_forms():
+    # A solid ball rolling on level ground with rolling resistance mu_r slows at
+    # (5/7) mu_r g (torque mu_r r N against I = 2/5 m r^2 and the rolling constraint) and
+    # stops after v^2 / 2a; spinning about the vertical on its point of contact with
+    # torsional friction mu_t (m) it slows at mu_t m g / I. The engine meets both within
+    # 0.2 % (crates/tumble/tests/rolling_friction.rs); 1 % leaves room. The ground has
+    # neither coefficient: a pair uses the larger.
+    r, mu_r, mu_t, v0, w0, dt = 0.1, 0.05, 0.002, 2.0, 20.0, 1 / 120
+    world = tumble.World()
+    world.sleep = False
+    world.add_body(tumble.Plane((0, 1, 0)), kind="static", friction=0.8)
+    roller = world.add_body(tumble.Sphere(r), mass=1.0, position=(0, r, 0), velocity=(v0, 0, 0),
+                            angular_velocity=(0, 0, -v0 / r), friction=0.8, rolling_resistance=mu_r)
+    spinner = world.add_body(tumble.Sphere(r), mass=1.0, position=(5, r, 5), angular_velocity=(0, w0, 0),
+                             torsional_friction=mu_t)
+    assert (roller.rolling_resistance, roller.torsional_friction) == (mu_r, 0.0)
+    assert (spinner.rolling_resistance, spinner.torsional_friction) == (0.0, mu_t)
+    a = 5 / 7 * mu_r * G
+    spin = mu_t * G / (0.4 * r * r)
+    t1 = 0.5 * w0 / spin  # 2.04 s: the spinner at half speed
+    world.simulate(duration=t1, dt=dt)
+    assert spinner.angular_velocity[1] == pytest.approx(w0 - spin * t1, rel=0.01)
+    t2 = 0.5 * v0 / a  # 2.86 s: the roller at half speed
+    world.simulate(duration=t2 - t1, dt=dt)
+    assert roller.velocity[0] == pytest.approx(v0 - a * t2, rel=0.01)
+    world.simulate(duration=1.2 * v0 / a - t2, dt=dt)
+    assert abs(roller.velocity[0]) < 1e-3
+    assert roller.position[0] == pytest.approx(v0 * v0 / (2 * a), rel=0.01)
+    assert abs(spinner.angular_velocity[1]) < 1e-3
+
 def test_distance_joint_pendulum_period():
     # A point-like ball on a 1 m rod swinging 0.1 rad: period 2 pi sqrt(L/g) (1 + theta^2/16)
     # to 0.1%; the rod length holds to 1 mm under the joint solver's soft correction.

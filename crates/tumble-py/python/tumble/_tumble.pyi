@@ -168,6 +168,12 @@ class Body:
     @property
     def restitution(self) -> float:
         """Coefficient of restitution."""
+    @property
+    def rolling_resistance(self) -> float:
+        """Rolling resistance coefficient (dimensionless): rolling torque at most μ_r r N."""
+    @property
+    def torsional_friction(self) -> float:
+        """Torsional friction (m): spinning torque about the contact normal at most μ_t N."""
     def apply_impulse(self, impulse: Vec3Like, point: Optional[Vec3Like] = None) -> None:
         """Applies an impulse (N·s) at a world point (m; default the centre of mass)."""
     def wake(self) -> None:
@@ -356,6 +362,8 @@ class World:
         center_of_mass: Optional[Vec3Like] = None,
         friction: float = 0.6,
         restitution: float = 0.0,
+        rolling_resistance: float = 0.0,
+        torsional_friction: float = 0.0,
         collision_group: int = 1,
         collision_mask: int = 0xFFFFFFFF,
         bullet: bool = False,
