@@ -14,6 +14,7 @@ use std::borrow::{Borrow, BorrowMut};
 use super::angular::AngularRows;
 use super::body::{BodySim, BodyState};
 use super::contact_wide::ContactLanes;
+use super::restitution::impact_velocity;
 use super::rows::{self, Frame, Masks, Motion, Pair, Pass, Sums};
 pub(super) use super::rows::{Point, Row};
 use super::softness::Softness;
@@ -95,6 +96,12 @@ pub(crate) struct PointCold {
     pub(super) sums: Sums,
     /// Normal velocity before the step, as it was.
     pub(super) start_velocity: Real,
+    /// The normal velocity the point reaches at the surface if the bodies fly freely from
+    /// the step's start: see `super::restitution::impact_velocity`.
+    pub(super) impact_velocity: Option<Real>,
+    /// The rate gravity changes the normal velocity at (m/s², negative: closing), where
+    /// known.
+    pub(super) fall: Option<Real>,
     /// The bounce pass's replay of the step's impacts (see `super::restitution`): the
     /// fastest approach seen, the impulse accumulated, and the separation speed reached.
     pub(super) replay_approach: Real,
@@ -168,6 +175,10 @@ pub(crate) struct PairData {
     /// The contact slop (m): friction anchors farther than this from their point have
     /// rolled away (pairs with angular rows, see `super::angular`).
     pub slop: Real,
+    /// Each body's acceleration under gravity this step (zero for bodies the solver does
+    /// not move), for the speed a falling point reaches at the surface; `None` when both
+    /// move under gravity, as one may be resting on something else and not fall at all.
+    pub gravity: Option<(Vec3, Vec3)>,
 }
 
 /// One manifold as the solver works on it; its points are `count` entries of [`Points`]
@@ -313,12 +324,15 @@ impl ContactConstraint {
             });
             let start_velocity = Pair::load(&states[a], &states[b]);
             let start_velocity = normal_row.velocity(normal, ra, rb, &start_velocity);
+            let fall = pair.gravity.map(|(ga, gb)| normal.dot(gb - ga));
             points.cold.push(PointCold {
                 sums: Sums {
                     approach_velocity: start_velocity,
                     ..Sums::default()
                 },
                 start_velocity,
+                impact_velocity: impact_velocity(start_velocity, mp.separation, fall),
+                fall,
                 ..PointCold::default()
             });
         }

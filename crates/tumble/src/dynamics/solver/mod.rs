@@ -106,7 +106,13 @@ impl Solver {
             input.joints,
             input.joint_bodies,
         );
-        self.prepare(bodies, contacts, input.ghosts, input.scales.linear_slop);
+        let gravity = input.system.gravity;
+        self.prepare(
+            bodies,
+            contacts,
+            input.ghosts,
+            (input.scales.linear_slop, gravity),
+        );
         self.prepare_joints(bodies, world_bodies, input.joints, input.joint_bodies);
         let passes = joint_passes(input.settings, time);
         let any_split = self.split_kicks(bodies);
@@ -124,7 +130,11 @@ impl Solver {
             &mut bodies.states,
             &self.start_states,
             &self.moving,
-            input.scales.restitution_threshold,
+            restitution::bounce_threshold(
+                input.system.gravity,
+                time.h,
+                input.scales.restitution_threshold,
+            ),
         );
         for c in &self.constraints {
             c.store_impulses(&self.points, &mut contacts[c.contact]);
@@ -243,11 +253,18 @@ impl Solver {
         bodies: &SolverBodies,
         contacts: &[Contact],
         ghosts: &[bool],
-        slop: Real,
+        (slop, gravity): (Real, Vec3),
     ) {
         self.constraints.clear();
         self.points.clear();
         let order = self.colour_order(&bodies.sims, contacts, ghosts);
+        let falls = |s: &BodySim| {
+            if s.moves {
+                gravity * s.linear_mask
+            } else {
+                Vec3::ZERO
+            }
+        };
         self.heavy_contacts = order.partition_point(|&(heavy, _, _)| !heavy);
         for (_, colour, i) in order {
             let c = &contacts[i];
@@ -265,6 +282,8 @@ impl Solver {
                 angular: angular::combine(sa, sb),
                 poses: (pose(a), pose(b)),
                 slop,
+                gravity: (!(sa.moves && sb.moves) || gravity == Vec3::ZERO)
+                    .then(|| (falls(sa), falls(sb))),
             };
             self.constraints.push(ContactConstraint::prepare(
                 (i, colour),

@@ -27,7 +27,7 @@ use std::borrow::BorrowMut;
 use super::body::BodyState;
 use super::contact::{BiasRule, ANCHOR_STIFFNESS};
 use super::wide::{LaneMask, Vector, Wide};
-use crate::math::Real;
+use crate::math::{Real, Vec3};
 
 /// One Jacobian row at one point: the images under I⁻¹ of its angular parts, and its
 /// effective mass. The angular parts r × d themselves are recomputed where needed: two
@@ -172,8 +172,16 @@ impl<W: Wide> Moved<W> {
 
     /// `start` (s₀ or an anchor gap) moved by the bodies' motion, less the lever.
     #[inline(always)]
-    fn gap(&self, start: W, ra: W::V3, rb: W::V3, lever: W) -> W {
+    pub(super) fn gap(&self, start: W, ra: W::V3, rb: W::V3, lever: W) -> W {
         start + self.offset + self.turn_b.dot(rb) - self.turn_a.dot(ra) - lever
+    }
+}
+
+impl Point {
+    /// The point's separation now, from the motion of states `a`, `b` since the step
+    /// began (their `dp`, `dr`).
+    pub fn separation_now(&self, n: Vec3, a: &BodyState, b: &BodyState) -> Real {
+        Moved::along(n, &Motion::of(a, b)).gap(self.separation, self.ra, self.rb, self.lever)
     }
 }
 

@@ -98,6 +98,7 @@ impl StepTime {
 pub(crate) struct Scales {
     pub linear_slop: Real,
     pub max_push: Real,
+    /// Floor of the bounce threshold (see `restitution::bounce_threshold`).
     pub restitution_threshold: Real,
 }
 

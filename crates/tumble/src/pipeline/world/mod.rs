@@ -114,7 +114,7 @@ impl Tolerances {
             scales: Scales {
                 linear_slop: slop,
                 max_push: 3.0 * length_unit,
-                restitution_threshold: 1.0 * length_unit,
+                restitution_threshold: 0.01 * length_unit,
             },
             sleep_speed: 0.05 * length_unit,
         }
@@ -394,12 +394,19 @@ impl World {
     /// manifold; points keep last update's impulses where their feature ids match. At most
     /// [`ContactLimits::per_step`] are returned (a step that needs more fails).
     pub fn update_contacts(&mut self) -> &[Contact] {
+        self.update_contacts_for(0.0)
+    }
+
+    /// The contact update before a step of `dt`: pairs that can close more than the
+    /// contact margin within it get a margin as wide as that.
+    pub(crate) fn update_contacts_for(&mut self, dt: Real) -> &[Contact] {
         let c = &mut self.collision;
+        let step = (dt, self.settings.gravity.length() * dt);
         c.contacts.update(
             &mut c.broad_phase,
             &self.bodies.list,
             self.bodies.ids(),
-            self.settings.tolerances.contact_margin,
+            (self.settings.tolerances.contact_margin, step),
             &self.joints.joined_pairs,
             &self.settings.contacts,
         );

@@ -76,7 +76,7 @@ impl World {
         let time = StepTime::new(self.clock.time, dt, &self.settings.solver);
         self.refresh_joint_links();
         self.keep_undo();
-        self.update_contacts();
+        self.update_contacts_for(dt);
         self.check_contacts(&time)?;
         self.wake_touched();
         self.gather();
