@@ -134,6 +134,25 @@ impl Shape {
         )
     }
 
+    /// The radius by which sub-shape `sub` (a compound's child index, as manifolds name
+    /// it; ignored otherwise) is round about its core: a sphere's or a capsule's radius.
+    /// A contact point on such a surface is its core's nearest point moved by this radius
+    /// along the contact normal, so as the body turns it stays where the normal says
+    /// rather than turning with the body. Zero for every other shape (box, hull and
+    /// cylinder contacts sit at body-fixed corners and edges; planes, meshes and height
+    /// fields are static) and for a compound child that is itself a compound (manifolds
+    /// name only the outer child).
+    pub fn round_radius(&self, sub: u32) -> Real {
+        match self {
+            Shape::Sphere { radius } | Shape::Capsule { radius, .. } => *radius,
+            Shape::Compound(children) => match children.get(sub as usize).map(|c| &c.shape) {
+                Some(Shape::Sphere { radius } | Shape::Capsule { radius, .. }) => *radius,
+                _ => 0.0,
+            },
+            _ => 0.0,
+        }
+    }
+
     /// Checks sizes and nesting; field paths are relative to the shape itself.
     pub fn validate(&self) -> Result<()> {
         match self {

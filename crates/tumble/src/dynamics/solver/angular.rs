@@ -28,7 +28,7 @@
 //! contact slows at ω̇ = μ_t m g / I. Both are measured in `tests/rolling_friction.rs`.
 
 use super::body::BodySim;
-use super::contact::{PairData, Point};
+use super::contact::Point;
 use super::rows::Pair;
 use crate::collision::narrow_phase::Manifold;
 use crate::math::{Real, Vec3};
@@ -90,9 +90,6 @@ pub(crate) struct AngularRows {
     twist_mass: Real,
     /// Accumulated impulses about t₁, t₂ (rolling) and n (twist) (N·m·s).
     impulse: [Real; 3],
-    /// Bit j: point j's friction anchors had rolled away (see
-    /// [`AngularRows::renew_rolled_anchors`]).
-    rolled: u8,
 }
 
 impl AngularRows {
@@ -130,33 +127,6 @@ impl AngularRows {
                 warm(1, rolling > 0.0),
                 warm(2, twist > 0.0),
             ],
-            rolled: 0,
-        }
-    }
-
-    /// Renews the friction anchors of the points that rolled: where either body's anchor
-    /// lies farther than the slop from where the bodies now touch, the bodies turned on
-    /// each other (the material points in touch change as a ball rolls) rather than stuck.
-    /// Such a point's anchors are taken as this step's contact point (no gap), and it is
-    /// reported sliding so that the contact cache re-anchors it there for the next step.
-    /// Kept over a roll, the anchors hold the point that touched a while ago: their spring
-    /// pulls the bodies back in the biased pass, the relax pass takes the velocity out
-    /// again, and the position lags (a ball rolling at 0.5 m/s moved at 0.465 m/s at dt
-    /// 1/60 s; one stopped by rolling resistance slid back towards its old anchor at
-    /// 3 cm/s). Only pairs with angular rows are checked: for the others the check would
-    /// change every result with a rolling body (docs/integrators.md).
-    pub fn renew_rolled_anchors(&mut self, m: &Manifold, pair: &PairData, hot: &mut [Point]) {
-        let (pa, pb) = (&pair.poses.0, &pair.poses.1);
-        let d2 = pair.slop * pair.slop;
-        for (j, (mp, p)) in m.points().iter().zip(hot).enumerate() {
-            let here = (mp.point_a + mp.point_b) * 0.5;
-            let far = |anchor: Vec3| (anchor - here).length_squared() > d2;
-            if mp.anchored
-                && (far(pa.transform_point(mp.anchor_a)) || far(pb.transform_point(mp.anchor_b)))
-            {
-                p.anchor_gap = [0.0; 2];
-                self.rolled |= 1 << j;
-            }
         }
     }
 
@@ -210,13 +180,10 @@ impl AngularRows {
     }
 
     /// Into the manifold: the accumulated impulse as a world vector on body b (N·m·s),
-    /// for the next step's warm start and for reports, and the rolled points as sliding.
+    /// for the next step's warm start and for reports.
     pub fn store(&self, m: &mut Manifold) {
         let [i0, i1, i2] = self.impulse;
         m.angular_impulse = self.axes[0] * i0 + self.axes[1] * i1 + self.axes[2] * i2;
-        for (j, p) in m.points_mut().iter_mut().enumerate() {
-            p.sliding |= self.rolled & (1 << j) != 0;
-        }
     }
 }
 

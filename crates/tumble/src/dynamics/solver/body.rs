@@ -63,6 +63,9 @@ pub(crate) struct BodyState {
     pub dp: Vec3,
     /// Rotation since the step began.
     pub dr: Mat3,
+    /// ∫ω dt since the step began (rad): how far a round body has rolled (see
+    /// `rows::Moved::tangent`), which ΔR cannot tell past a half turn.
+    pub turned: Vec3,
 }
 
 /// The rest of a body's solver data.
@@ -94,6 +97,9 @@ pub(crate) struct BodySim {
     /// Rolling resistance (dimensionless) and torsional friction (m); see `BodyDef`.
     pub rolling_resistance: Real,
     pub torsional_friction: Real,
+    /// The shape's `Shape::round_radius`, or `None` for a compound, whose children differ:
+    /// read here, the step's contacts need not reach into the bodies' shapes.
+    pub round: Option<Real>,
 }
 
 impl BodySim {
@@ -136,12 +142,17 @@ impl BodySim {
             local_center: body.local_center,
             rolling_resistance: body.rolling_resistance,
             torsional_friction: body.torsional_friction,
+            round: match body.shape {
+                crate::collision::shape::Shape::Compound(_) => None,
+                ref shape => Some(shape.round_radius(0)),
+            },
         };
         let state = BodyState {
             v: m.v,
             w: m.w,
             dp: Vec3::ZERO,
             dr: Mat3::IDENTITY,
+            turned: Vec3::ZERO,
         };
         (sim, state)
     }

@@ -20,6 +20,7 @@ pub(super) use super::rows::{Point, Row};
 use super::softness::Softness;
 use crate::collision::contact::Contact;
 use crate::collision::geometry::Pose;
+use crate::collision::narrow_phase::{ContactPoint, Manifold};
 use crate::math::{orthonormal_basis, Real, Vec3};
 
 /// How position error turns into velocity in one substep.
@@ -172,8 +173,11 @@ pub(crate) struct PairData {
     pub angular: (Real, Real),
     /// The bodies' frames at the start of the step (for the friction anchors).
     pub poses: (Pose, Pose),
+    /// How far each side's touching sub-shape is round about its core
+    /// (`Shape::round_radius`): its turn does not move the contact along the normal.
+    pub round: (Real, Real),
     /// The contact slop (m): friction anchors farther than this from their point have
-    /// rolled away (pairs with angular rows, see `super::angular`).
+    /// rolled away (see [`anchor_gap`]).
     pub slop: Real,
     /// Each body's acceleration under gravity this step (zero for bodies the solver does
     /// not move), for the speed a falling point reaches at the surface; `None` when both
@@ -201,6 +205,9 @@ pub(crate) struct ContactConstraint {
     colour: u32,
     /// The manifold's rolling and twist rows in `Points::angular`, if its pair has either.
     angular: Option<u32>,
+    /// Bit j: point j's friction anchors had rolled away (see [`anchor_gap`]), so that it
+    /// is reported sliding and re-anchored where it touches.
+    rolled: u8,
 }
 
 /// How hard anchors pull, as a fraction of the contact spring's rate. At the full rate a
@@ -212,7 +219,7 @@ pub(super) const ANCHOR_STIFFNESS: Real = 0.5;
 /// The rolling and twist rows of manifold `m`, appended to `points`, if its pair has
 /// either coefficient; their index.
 fn angular_rows(
-    m: &crate::collision::narrow_phase::Manifold,
+    m: &Manifold,
     pair: &PairData,
     bodies: (&BodySim, &BodySim),
     tangents: [Vec3; 2],
@@ -228,6 +235,36 @@ fn angular_rows(
     }
 }
 
+/// Where the rows of point `mp` act: on the round side's own surface where one side of
+/// the pair is round (`round`: each side's `Shape::round_radius`), else midway between the
+/// two surfaces. A ball then rolls without slip where v = ω ρ, its radius, however deep it
+/// sinks into its soft contact; at the midpoint the rolling radius was ρ + s/2, which
+/// changed as the ball settled (s from 0 to −0.07 mm under its weight) and took 2e-6 m/s
+/// from a rolling ball's speed over the 4 s after it (docs/integrators.md, "Rolling
+/// contact"). Both anchors sit at the same world point, so friction's impulses still
+/// balance in angular momentum too.
+fn contact_point(mp: &ContactPoint, (a, b): (Real, Real)) -> Vec3 {
+    match (a > 0.0, b > 0.0) {
+        (true, false) => mp.point_a,
+        (false, true) => mp.point_b,
+        _ => (mp.point_a + mp.point_b) * 0.5,
+    }
+}
+
+/// Each side's distance along the normal from its round core to where the rows act
+/// (`contact_point`), for the gaps' round parts (`rows::Moved::normal`): its round radius
+/// ρ where only one side is round; ρ plus half the mean separation for each where both are
+/// (the rows act midway); 0 for a side that is not round.
+fn round_arms(m: &Manifold, (a, b): (Real, Real)) -> [Real; 2] {
+    if a > 0.0 && b > 0.0 {
+        let count = m.len().max(1) as Real;
+        let mean = m.points().iter().map(|p| p.separation).sum::<Real>() / count;
+        [a + 0.5 * mean, b + 0.5 * mean]
+    } else {
+        [a, b]
+    }
+}
+
 /// The two bodies' states, mutably; `a != b` always (a body never touches itself).
 pub(super) fn pair(
     states: &mut [BodyState],
@@ -236,6 +273,41 @@ pub(super) fn pair(
 ) -> Option<(&mut BodyState, &mut BodyState)> {
     let [x, y] = states.get_disjoint_mut([a, b]).ok()?;
     Some((x, y))
+}
+
+/// The tangential gap between point `mp`'s friction anchors at the step's start, along
+/// each tangent; zero for a new point, and `None` for one whose anchors rolled away:
+/// either lies farther than the slop from where the bodies now touch (`at`), so the
+/// bodies turned on each other (the material points in touch change as a ball rolls)
+/// rather than stuck. Such a point's anchors are taken as this step's contact point (no
+/// gap), and it is reported sliding so that the contact cache re-anchors it there for the
+/// next step. A rolling contact never slides, and kept over a roll its anchors hold the
+/// point that touched a while ago: their spring pulled the bodies back in the biased pass,
+/// the relax pass took the velocity out again, and the position lagged (a 0.3 m ball
+/// rolling at 0.5 m/s moved at 0.465 m/s at dt 1/60 s while its velocity said 0.5; one
+/// stopped by rolling resistance slid back towards its old anchor at 3 cm/s). A body
+/// that sticks keeps its anchors: they stay within the slop (of their creep) unless it
+/// slides, and then friction's cone renews them anyway.
+fn anchor_gap(
+    mp: &ContactPoint,
+    at: Vec3,
+    pair: &PairData,
+    tangents: [Vec3; 2],
+) -> Option<[Real; 2]> {
+    if !mp.anchored {
+        return Some([0.0; 2]);
+    }
+    let (pa, pb) = &pair.poses;
+    let (wa, wb) = (
+        pa.transform_point(mp.anchor_a),
+        pb.transform_point(mp.anchor_b),
+    );
+    let d2 = pair.slop * pair.slop;
+    if (wb - at).length_squared() > d2 {
+        return None;
+    }
+    let gap = wb - wa;
+    Some([tangents[0].dot(gap), tangents[1].dot(gap)])
 }
 
 impl ContactConstraint {
@@ -256,7 +328,7 @@ impl ContactConstraint {
         let tangents = orthonormal_basis(normal);
         let dirs = [normal, tangents[0], tangents[1]];
         let push = |s: &BodySim, k: usize| s.linear_mask * dirs[k] * s.inv_mass;
-        let c = ContactConstraint {
+        let mut c = ContactConstraint {
             a,
             b,
             contact: index,
@@ -266,6 +338,7 @@ impl ContactConstraint {
                 push_a: [push(sa, 0), push(sa, 1), push(sa, 2)],
                 push_b: [push(sb, 0), push(sb, 1), push(sb, 2)],
                 friction,
+                round: round_arms(m, pair.round),
             },
             moves: (sa.moves, sb.moves),
             restitution,
@@ -273,16 +346,14 @@ impl ContactConstraint {
             count: m.len(),
             colour,
             angular: angular_rows(m, pair, (sa, sb), tangents, points),
+            rolled: 0,
         };
-        c.add_points(contact, pair, sims, states, points);
-        if let Some(k) = c.angular {
-            let hot = &mut points.hot[c.range()];
-            points.angular[k as usize].renew_rolled_anchors(m, pair, hot);
-        }
+        c.rolled = c.add_points(contact, pair, sims, states, points);
         c
     }
 
-    /// Appends the manifold's points to `points`: anchors, rows, warm starts.
+    /// Appends the manifold's points to `points`: anchors, rows, warm starts; which of
+    /// them had rolled off their anchors (bit j for point j).
     fn add_points(
         &self,
         contact: &Contact,
@@ -290,13 +361,16 @@ impl ContactConstraint {
         sims: &[BodySim],
         states: &[BodyState],
         points: &mut Points,
-    ) {
+    ) -> u8 {
         let (a, b) = pair.bodies;
-        let (sa, sb, poses) = (&sims[a], &sims[b], pair.poses);
+        let (sa, sb) = (&sims[a], &sims[b]);
         let (normal, tangents) = (self.frame.normal, self.frame.tangents);
-        for mp in contact.manifold.points() {
-            let mid = (mp.point_a + mp.point_b) * 0.5;
-            let (ra, rb) = (mid - sa.x, mid - sb.x);
+        let mut rolled = 0;
+        for (j, mp) in contact.manifold.points().iter().enumerate() {
+            let at = contact_point(mp, pair.round);
+            let anchor_gap = anchor_gap(mp, at, pair, tangents);
+            rolled |= u8::from(anchor_gap.is_none()) << j;
+            let (ra, rb) = (at - sa.x, at - sb.x);
             let normal_row = Row::new(normal, ra, rb, sa, sb);
             points.hot.push(Point {
                 ra,
@@ -313,13 +387,7 @@ impl ContactConstraint {
                 // still point the same way.
                 tangent_impulse: mp.tangent_impulse,
                 max_normal_impulse: 0.0,
-                anchor_gap: if mp.anchored {
-                    let gap =
-                        poses.1.transform_point(mp.anchor_b) - poses.0.transform_point(mp.anchor_a);
-                    [tangents[0].dot(gap), tangents[1].dot(gap)]
-                } else {
-                    [0.0; 2]
-                },
+                anchor_gap: anchor_gap.unwrap_or([0.0; 2]),
                 tangent_lever: [tangents[0].dot(rb - ra), tangents[1].dot(rb - ra)],
             });
             let start_velocity = Pair::load(&states[a], &states[b]);
@@ -336,6 +404,7 @@ impl ContactConstraint {
                 ..PointCold::default()
             });
         }
+        rolled
     }
 
     /// Whether the manifold has rolling or twist rows (and so stays on the scalar path).
@@ -378,6 +447,11 @@ impl ContactConstraint {
 
     pub fn friction(&self) -> Real {
         self.frame.friction
+    }
+
+    /// Each side's round radius along the normal (see `rows::Moved::normal`).
+    pub fn round(&self) -> [Real; 2] {
+        self.frame.round
     }
 
     /// The masks of the manifold's points: one lane, always active, reaching the bodies
@@ -450,6 +524,12 @@ impl ContactConstraint {
             mp.sliding = p.normal_impulse == 0.0 || friction >= 0.999 * cone;
             let t = self.frame.tangents;
             mp.total_tangent_impulse = t[0] * c.total_tangent[0] + t[1] * c.total_tangent[1];
+        }
+        // Rare (a contact that rolled on), so tested once per manifold.
+        if self.rolled != 0 {
+            for (j, mp) in contact.manifold.points_mut().iter_mut().enumerate() {
+                mp.sliding |= self.rolled >> j & 1 != 0;
+            }
         }
         match self.angular {
             Some(k) => points.angular[k as usize].store(&mut contact.manifold),

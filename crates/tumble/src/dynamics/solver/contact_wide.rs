@@ -52,6 +52,8 @@ struct Group {
     moves_b: u32,
     /// Each lane's manifold frame.
     frame: Frame<Lanes>,
+    /// Whether a lane's manifold has a round side (only then are ∫ω dt gathered).
+    round: bool,
     /// The group's slots, `slots` of them from `slot0`.
     slot0: usize,
     slots: usize,
@@ -151,7 +153,12 @@ impl ContactLanes {
                 push_a: std::array::from_fn(|k| vec(&|c| c.pushes().0[k])),
                 push_b: std::array::from_fn(|k| vec(&|c| c.pushes().1[k])),
                 friction: Lanes::from_fn(|l| lane(l).friction()),
+                round: [
+                    Lanes::from_fn(|l| lane(l).round()[0]),
+                    Lanes::from_fn(|l| lane(l).round()[1]),
+                ],
             },
+            round: cs.iter().any(|c| c.round()[0] + c.round()[1] > 0.0),
             slot0,
             slots,
         };
@@ -281,6 +288,16 @@ impl Group {
                 Lanes3::gather(states, &self.b, |s| s.dp),
             ],
             dr: [rotation(states, &self.a), rotation(states, &self.b)],
+            // Read by the round gaps alone (`Moved::tangent`), which a group without a round
+            // side skips.
+            turned: if self.round {
+                [
+                    Lanes3::gather(states, &self.a, |s| s.turned),
+                    Lanes3::gather(states, &self.b, |s| s.turned),
+                ]
+            } else {
+                [Lanes3::default(); 2]
+            },
         }
     }
 

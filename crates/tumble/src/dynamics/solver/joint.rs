@@ -243,6 +243,7 @@ impl JointConstraint {
             w: Vec3::ZERO,
             dp: Vec3::ZERO,
             dr: Mat3::IDENTITY,
+            turned: Vec3::ZERO,
         };
         match (self.a, self.b) {
             (Some(a), Some(b)) => match states.get_disjoint_mut([a, b]) {

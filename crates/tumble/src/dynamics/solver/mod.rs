@@ -108,7 +108,7 @@ impl Solver {
         );
         let gravity = input.system.gravity;
         self.prepare(
-            bodies,
+            (bodies, world_bodies),
             contacts,
             input.ghosts,
             (input.scales.linear_slop, gravity),
@@ -247,10 +247,11 @@ impl Solver {
     }
 
     /// The step's contact constraints, in colour order, and their lane groups; `slop` (m)
-    /// tells rolled friction anchors (see `angular::AngularRows::renew_rolled_anchors`).
+    /// tells rolled friction anchors (see `contact::anchor_gap`), the world's bodies
+    /// their shapes' round radii.
     fn prepare(
         &mut self,
-        bodies: &SolverBodies,
+        (bodies, world_bodies): (&SolverBodies, &[Body]),
         contacts: &[Contact],
         ghosts: &[bool],
         (slop, gravity): (Real, Vec3),
@@ -281,6 +282,14 @@ impl Solver {
                 material: (friction, restitution),
                 angular: angular::combine(sa, sb),
                 poses: (pose(a), pose(b)),
+                round: (
+                    sa.round.unwrap_or_else(|| {
+                        world_bodies[a].shape.round_radius(c.manifold.subshape_a)
+                    }),
+                    sb.round.unwrap_or_else(|| {
+                        world_bodies[b].shape.round_radius(c.manifold.subshape_b)
+                    }),
+                ),
                 slop,
                 gravity: (!(sa.moves && sb.moves) || gravity == Vec3::ZERO)
                     .then(|| (falls(sa), falls(sb))),
@@ -455,6 +464,8 @@ impl Solver {
     fn drift(&mut self, solver_bodies: &mut SolverBodies, bodies: &[Body], h: Real) {
         let (sims, states) = (&mut solver_bodies.sims, &mut solver_bodies.states);
         for ((sim, state), body) in sims.iter_mut().zip(states.iter_mut()).zip(bodies) {
+            // The ω the substep's rows saw: the one the drift turns with.
+            state.turned += state.w * h;
             match (sim.moves, body.kind) {
                 (true, _) => {
                     sim.sync_momentum(state);
