@@ -158,7 +158,7 @@ impl ContactLanes {
                     Lanes::from_fn(|l| lane(l).round()[1]),
                 ],
             },
-            round: cs.iter().any(|c| c.round()[0] + c.round()[1] > 0.0),
+            round: cs.iter().any(|c| c.has_round()),
             slot0,
             slots,
         };

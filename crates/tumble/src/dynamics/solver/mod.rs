@@ -247,7 +247,7 @@ impl Solver {
     }
 
     /// The step's contact constraints, in colour order, and their lane groups; `slop` (m)
-    /// tells rolled friction anchors (see `contact::anchor_gap`), the world's bodies
+    /// tells rolled friction anchors (see `contact::rolled_away`), the world's bodies
     /// their shapes' round radii.
     fn prepare(
         &mut self,
@@ -464,10 +464,10 @@ impl Solver {
     fn drift(&mut self, solver_bodies: &mut SolverBodies, bodies: &[Body], h: Real) {
         let (sims, states) = (&mut solver_bodies.sims, &mut solver_bodies.states);
         for ((sim, state), body) in sims.iter_mut().zip(states.iter_mut()).zip(bodies) {
-            // The ω the substep's rows saw: the one the drift turns with.
-            state.turned += state.w * h;
             match (sim.moves, body.kind) {
                 (true, _) => {
+                    // The ω the substep's rows saw: the one the drift turns with.
+                    state.turned += state.w * h;
                     sim.sync_momentum(state);
                     sim.x += state.v * h;
                     sim.q = rotor_drift(body, sim.q, sim.l, state.w, h);
@@ -475,6 +475,7 @@ impl Solver {
                     sim.w_synced = state.w;
                 }
                 (false, BodyKind::Kinematic) => {
+                    state.turned += state.w * h;
                     sim.x += state.v * h;
                     sim.q = exact_spin(state.w, sim.q, h);
                 }
