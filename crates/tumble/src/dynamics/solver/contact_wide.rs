@@ -578,6 +578,53 @@ mod tests {
         w
     }
 
+    /// Round bodies rolling side by side, so that their contacts fill lane groups whose
+    /// gaps have round parts (`rows::Moved::normal`, `rows::Moved::tangent`): balls,
+    /// lying capsules, compounds of two balls, boxes among them (groups mixing round and
+    /// flat manifolds), and balls resting on capsules (both sides round).
+    fn rollers() -> World {
+        let mut w = world_on_ground();
+        let lying = Quat::from_rotation_x(std::f64::consts::FRAC_PI_2 as Real);
+        for i in 0..24 {
+            let (r, z) = (0.2 + 0.05 * (i % 4) as Real, 1.5 * i as Real);
+            let v = 0.5 + 0.4 * i as Real;
+            let (shape, orientation) = match i % 4 {
+                0 => (Shape::sphere(r), Quat::IDENTITY),
+                1 => (Shape::capsule(r, 0.3), lying),
+                2 => (
+                    Shape::Compound(
+                        [-0.3, 0.3]
+                            .map(|dz| CompoundChild {
+                                shape: Shape::sphere(r),
+                                position: Vec3::new(0.0, 0.0, dz),
+                                orientation: Quat::IDENTITY,
+                            })
+                            .to_vec(),
+                    ),
+                    Quat::IDENTITY,
+                ),
+                _ => (Shape::cuboid(Vec3::splat(r)), Quat::IDENTITY),
+            };
+            let def = BodyDef {
+                position: Vec3::new(0.0, r, z),
+                orientation,
+                linear_velocity: Vec3::new(v, 0.0, 0.0),
+                angular_velocity: Vec3::new(0.0, 0.0, -v / r),
+                ..Default::default()
+            };
+            w.create_body(&def, shape).unwrap();
+            if i % 4 == 1 {
+                let on_top = BodyDef {
+                    position: Vec3::new(0.0, 2.0 * r + 0.1, z),
+                    linear_velocity: Vec3::new(v, 0.0, 0.0),
+                    ..Default::default()
+                };
+                w.create_body(&on_top, Shape::sphere(0.1)).unwrap();
+            }
+        }
+        w
+    }
+
     /// The state bits and every contact's impulses after a second of `scene`.
     fn run(mode: LaneMode, scene: fn() -> World) -> (u64, String) {
         with_lane_mode(mode, || {
@@ -594,7 +641,7 @@ mod tests {
         // The lane passes perform each lane's scalar operations in the scalar order
         // (module docs): trajectories and reported impulses must agree to the bit,
         // whichever kernels this CPU runs.
-        for scene in [pile, row, rolling_pile] {
+        for scene in [pile, row, rolling_pile, rollers] {
             let scalar = run(LaneMode::Scalar, scene);
             assert_eq!(run(LaneMode::Portable, scene), scalar);
             assert_eq!(run(LaneMode::Avx2, scene), scalar);
