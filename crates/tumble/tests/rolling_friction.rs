@@ -458,9 +458,9 @@ fn the_coefficients_are_checked_where_they_enter() {
 #[test]
 fn a_ball_with_rolling_resistance_moves_as_its_velocity_says() {
     // Friction anchors of a pair with angular rows are renewed as the contact rolls on
-    // (`AngularRows::renew_rolled_anchors`): stale anchors pulled a slowly rolling ball
-    // back in the biased pass, and its position lagged its velocity by 6 % at dt 1/60 (the
-    // lag pairs without either coefficient still have, docs/integrators.md). Measured: 1e-4.
+    // (`solver::contact::rolled_away`; for round bodies without either coefficient too,
+    // `tests/rolling_contact.rs`): stale anchors pulled a slowly rolling ball back in the
+    // biased pass, and its position lagged its velocity by 6 % at dt 1/60. Measured: 1e-4.
     for dt in [1.0 / 60.0, 1.0 / 240.0] {
         let mut w = world(false);
         ground(&mut w, Vec3::Y, (0.0, 0.0));

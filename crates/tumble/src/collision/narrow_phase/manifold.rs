@@ -49,9 +49,10 @@ pub struct ContactPoint {
     pub anchor_b: Vec3,
     /// Whether the anchors hold (false for a new point, or one that slid last step).
     pub anchored: bool,
-    /// Whether friction reached its cone at this point last step, or (for pairs with
-    /// rolling resistance or torsional friction) its anchors had rolled away: either way
-    /// it is re-anchored where it now touches.
+    /// Whether friction reached its cone at this point last step, or (for pairs that can
+    /// roll: a sphere or capsule on either side, or rolling resistance or torsional
+    /// friction) its anchors had rolled away: either way it is re-anchored where it now
+    /// touches.
     pub sliding: bool,
 }
 
