@@ -572,13 +572,25 @@ impl Motion {
 }
 
 /// The thickness below which a step's travel counts as fast: half the smallest extent of
-/// the shape's bounding box, or of its thinnest compound child.
+/// the shape's bounding box, or of its thinnest compound child; for a hull, the radius of
+/// the largest ball about its vertices' mean that it holds (the box overstates a hull
+/// turned in its frame: an octahedron's box is √3 times its inner ball, and a face-on
+/// octahedron moving just under its box's half extent a step would take its centre past
+/// a surface before any contact saw it).
 fn ccd_extent(shape: &Shape) -> Real {
     match shape {
         Shape::Compound(children) => children
             .iter()
             .map(|c| ccd_extent(&c.shape))
             .fold(Real::INFINITY, Real::min),
+        Shape::ConvexHull(hull) => {
+            let v = hull.vertices();
+            let mean = v.iter().copied().sum::<Vec3>() / v.len().max(1) as Real;
+            hull.face_planes()
+                .iter()
+                .map(|(n, d)| d - n.dot(mean))
+                .fold(Real::INFINITY, Real::min)
+        }
         _ => shape
             .aabb(&crate::collision::geometry::Pose::IDENTITY)
             .half_extents()
