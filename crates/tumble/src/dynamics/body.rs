@@ -147,6 +147,9 @@ pub struct Body {
     pub(crate) bullet: bool,
     /// Half the body's thinnest extent: moving farther in a step makes it a CCD candidate.
     pub(crate) ccd_extent: Real,
+    /// How far any point of the shape lies from the centre of mass, at most (m): what a
+    /// turn moves points by, for the same test.
+    pub(crate) ccd_reach: Real,
     /// False while the body's island sleeps.
     pub(crate) awake: bool,
     /// How long the body has been below the sleep thresholds (s).
@@ -208,6 +211,7 @@ impl Body {
             torsional_friction: def.torsional_friction,
             bullet: def.bullet,
             ccd_extent: 0.0,
+            ccd_reach: 0.0,
             awake: true,
             sleep_time: 0.0,
             island_tag: 0,
@@ -229,6 +233,7 @@ impl Body {
             angular_velocity: def.angular_velocity,
         };
         body.ccd_extent = ccd_extent(&body.shape);
+        body.ccd_reach = body.shape.bounding_radius() + body.local_center.length();
         let r = Mat3::from_quat(orientation);
         body.planar_inertia = (r * props.inertia * r.transpose()).z_axis.z;
         if body.planar {

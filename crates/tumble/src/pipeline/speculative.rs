@@ -16,12 +16,11 @@
 use crate::collision::contact::Contact;
 use crate::collision::geometry::Pose;
 use crate::collision::narrow_phase::within;
-use crate::collision::query::Sweep;
+use crate::collision::query::{sweep_shapes, Stop, Sweep};
 use crate::collision::shape::Convex;
 use crate::collision::shape::Shape;
 use crate::dynamics::body::{Body, BodyKind};
 use crate::math::{Real, Vec3};
-use crate::pipeline::ccd::shape_toi;
 
 /// Marks in `ghost` the contacts whose speculative points the bodies will not reach within
 /// `horizon` (true = leave out of the solver). The horizon is the step plus one substep:
@@ -80,11 +79,11 @@ fn is_ghost(bodies: &[Body], c: &Contact, gravity: Vec3, dt: Real, slop: Real) -
     }
     // The sweep routine takes meshes, height fields and compounds' partners on its B side.
     let hit = if matches!(a.shape, Shape::TriMesh(_) | Shape::HeightField(_)) {
-        shape_toi(&b.shape, &sb, &a.shape, &sa, target, 1.0)
+        sweep_shapes(&b.shape, &sb, &a.shape, &sa, Stop::At(target), 1.0)
     } else {
-        shape_toi(&a.shape, &sa, &b.shape, &sb, target, 1.0)
+        sweep_shapes(&a.shape, &sa, &b.shape, &sb, Stop::At(target), 1.0)
     };
-    hit >= 1.0
+    hit.is_none()
 }
 
 /// Whether two convex shapes end their sweeps within `near` (< the sweep's target) of

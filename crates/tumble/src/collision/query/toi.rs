@@ -17,6 +17,12 @@
 //! t reached is returned: it is still no later than the first contact, which is what
 //! continuous collision needs).
 //!
+//! The same holds with signed distances: overlapping, d is minus the depth along the axis
+//! of least penetration, the largest separation along any axis, which the fixed axis's
+//! separation still bounds from below. So a negative target is a depth the shapes are not
+//! let past, which continuous collision uses for bodies that start a step touching (see
+//! `sweep.rs`); there the target and tolerance are picked from the distance at t = 0.
+//!
 //! A linear shape cast is the same with no rotation and target 0. For a point against a
 //! face the step is exact; against a curved surface or an edge it is Newton's method on a
 //! convex function of t, which converges from below, quadratically.
@@ -81,7 +87,36 @@ pub fn time_of_impact(
     } else {
         target.max(0.0)
     };
-    if !target.is_finite() || !sweep_a.is_finite() || !sweep_b.is_finite() {
+    if !target.is_finite() {
+        return None;
+    }
+    advance(a, sweep_a, b, sweep_b, |_| Goal { target, tol: None })
+}
+
+/// Where an advancement stops: the signed distance counted as impact (negative: a depth
+/// of interpenetration) and the tolerance above it within which the search has converged
+/// (`None`: 5 % of the target or the rounding of the pair's size and spacing, as
+/// [`time_of_impact`] does).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Goal {
+    pub target: Real,
+    pub tol: Option<Real>,
+}
+
+/// Conservative advancement to the goal `goal` picks from the signed distance at t = 0:
+/// the first t at which the distance is within the goal's tolerance above its target (t =
+/// 0 if it already is), or `None` if it never gets there. The argument of the module
+/// header holds for signed distances: overlapping, the distance is the largest separation
+/// along any axis (minus the depth), which the fixed axis's separation still bounds from
+/// below, so a negative target is a depth the shapes are not let past.
+pub(crate) fn advance(
+    a: &Convex,
+    sweep_a: &Sweep,
+    b: &Convex,
+    sweep_b: &Sweep,
+    goal: impl FnOnce(Real) -> Goal,
+) -> Option<Toi> {
+    if !sweep_a.is_finite() || !sweep_b.is_finite() {
         return None;
     }
     // Reach of each shape about its centre of rotation times its angular travel.
@@ -94,27 +129,40 @@ pub fn time_of_impact(
     let fixed =
         |s: &Sweep| (s.translation == Vec3::ZERO && s.rotation == Vec3::ZERO).then(|| s.at(0.0));
     let (fixed_a, fixed_b) = (fixed(sweep_a), fixed(sweep_b));
+    let mut goal = Some(goal);
+    let mut target = Goal {
+        target: 0.0,
+        tol: None,
+    };
     for iteration in 0..=MAX_ITERATIONS {
         let pa = fixed_a.unwrap_or_else(|| sweep_a.at(t));
         let pb = fixed_b.unwrap_or_else(|| sweep_b.at(t));
         let c = closest_points(a, &pa, b, &pb);
+        if let Some(pick) = goal.take() {
+            target = pick(c.distance);
+            if !target.target.is_finite() {
+                return None;
+            }
+        }
         // Rounding in the distance grows with the coordinates of the pair as it stands.
         let scale = size + (pa.position - pb.position).length();
-        let tol = (TARGET_TOL * target).max(ABS_TOL * scale);
+        let tol = target
+            .tol
+            .unwrap_or_else(|| (TARGET_TOL * target.target).max(ABS_TOL * scale));
         let toi = Toi {
             t,
             normal: c.normal,
             point_a: c.point_a,
             point_b: c.point_b,
         };
-        if c.distance <= target + tol || iteration == MAX_ITERATIONS {
+        if c.distance <= target.target + tol || iteration == MAX_ITERATIONS {
             return Some(toi);
         }
         let mu = dv.dot(c.normal) + spin_a + spin_b;
         if mu.is_nan() || mu <= 0.0 {
             return None;
         }
-        t += (c.distance - target) / mu;
+        t += (c.distance - target.target) / mu;
         if t.is_nan() || t > 1.0 {
             return None;
         }

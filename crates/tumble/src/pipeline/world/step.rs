@@ -49,6 +49,8 @@ pub(crate) struct StepContext {
     discarded: Vec<bool>,
     /// Per contact: a speculative contact the bodies will not reach this step.
     ghosts: Vec<bool>,
+    /// Per body: fast this step (swept by `sweep_fast`).
+    fast: Vec<bool>,
     /// The free integrator's ODE vector and its stages.
     ode: Vec<Motion>,
     integrate: Scratch,
@@ -218,9 +220,12 @@ impl World {
     fn sweep_fast(&mut self) {
         crate::pipeline::ccd::sweep_fast_bodies(
             &self.bodies.list,
-            &mut self.scratch.bodies,
-            &self.collision.broad_phase,
-            self.settings.tolerances.scales.linear_slop,
+            (&mut self.scratch.bodies, &mut self.scratch.fast),
+            (&self.collision.broad_phase, &self.joints.joined_pairs),
+            (
+                self.settings.tolerances.scales.linear_slop,
+                self.settings.tolerances.contact_margin,
+            ),
         );
     }
 
