@@ -70,6 +70,7 @@ impl Basis {
     }
 
     /// The manifold moved rigidly with the bodies to poses `pa`, `pb`.
+    #[inline]
     pub(crate) fn place(&self, m: &mut Manifold, pa: &Pose, pb: &Pose) {
         m.normal = pa.transform_vector(self.normal);
         let n = m.normal;
