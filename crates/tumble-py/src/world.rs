@@ -394,7 +394,8 @@ impl PyWorld {
     /// to the xy plane; `friction`, `restitution`, `rolling_resistance` (dimensionless:
     /// rolling torque at most μ_r r N) and `torsional_friction` (m: spinning torque at most
     /// μ_t N; a pair uses the larger of each), `collision_group`/`collision_mask`
-    /// (32-bit layer sets) and `bullet` (continuous collision against every body).
+    /// (32-bit layer sets) and `bullet` (continuous collision against every body that is
+    /// not a bullet).
     #[pyo3(signature = (shape, *, mass = None, density = None, position = None,
         orientation = None, velocity = None, angular_velocity = None,
         kind = "dynamic".to_string(), name = None, planar = false, inertia = None,

@@ -104,7 +104,8 @@ pub struct BodyDef {
     /// μ_t N. A flat patch of radius a pressed evenly, with friction μ, has μ_t = (2/3) μ a.
     /// A pair uses max(μ_a, μ_b). Default 0: none, at no cost.
     pub torsional_friction: Real,
-    /// Continuous collision against every body, not only static ones, for fast projectiles.
+    /// Continuous collision against every body that is not a bullet, not only static ones,
+    /// for fast projectiles (swept after the other fast bodies, along their motion).
     pub bullet: bool,
 }
 
