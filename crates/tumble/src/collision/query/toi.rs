@@ -119,9 +119,7 @@ pub(crate) fn advance(
     if !sweep_a.is_finite() || !sweep_b.is_finite() {
         return None;
     }
-    // Reach of each shape about its centre of rotation times its angular travel.
-    let spin_a = reach(a, sweep_a.local_center) * sweep_a.rotation.length();
-    let spin_b = reach(b, sweep_b.local_center) * sweep_b.rotation.length();
+    let (spin_a, spin_b) = (spin(a, sweep_a), spin(b, sweep_b));
     let dv = sweep_a.translation - sweep_b.translation;
     let size = reach(a, Vec3::ZERO) + reach(b, Vec3::ZERO);
     let mut t: Real = 0.0;
@@ -240,6 +238,30 @@ impl Sweep {
             && self.translation.is_finite()
             && self.rotation.is_finite()
             && self.local_center.is_finite()
+    }
+}
+
+/// How fast the sweep's turn can close a gap to the shape, per unit t: its reach about
+/// its centre of rotation times its angular travel, less what its symmetry leaves in
+/// place. A ball turning about its own centre fills the same region at every t, and a
+/// capsule or cylinder turning about its axis too; only the turn's part that swings the
+/// axis (|θ × a|, constant along a turn about a fixed axis) moves their surface, plus the
+/// centre's own motion about the centre of rotation. With the full reach, a capsule
+/// rolling at 8 m/s (1.3 rad a step, reach 0.4 m, resting 0.1 mm deep on a mesh) needed
+/// more advancements than allowed to cross the step, and the sweep reported an impact
+/// at the last one every step.
+fn spin(shape: &Convex, sweep: &Sweep) -> Real {
+    let theta = sweep.rotation;
+    let centre = theta.length() * sweep.local_center.length();
+    let swing = || theta.cross(sweep.start.rotation * Vec3::Y).length();
+    match shape {
+        Convex::Sphere { .. } => centre,
+        Convex::Capsule { half_height, .. } => swing() * half_height + centre,
+        Convex::Cylinder {
+            radius,
+            half_height,
+        } => swing() * radius.hypot(*half_height) + centre,
+        _ => reach(shape, sweep.local_center) * theta.length(),
     }
 }
 
