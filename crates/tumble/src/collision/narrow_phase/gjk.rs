@@ -46,6 +46,40 @@ const ABS_ULPS: Real = 16.0;
 /// touch or overlap: its direction is rounding noise, so the penetration routines decide.
 const TOUCH_ULPS: Real = 100.0;
 
+/// The sub-algorithm's vectors: f64 whatever `Real` is. The points of M are differences of
+/// support points as far out as the shapes are large, and a thin simplex's plane hangs on
+/// its short edges: in f32, a 1 cm edge between points 28 m out (a 1 cm capsule over a 40 m
+/// box) carries 3·10⁻⁴ of rounding, which tilts the plane enough to put it millimetres off
+/// at the origin, and GJK stopped at the capsule's middle instead of its lower end. Taken in
+/// f64 from the f32 support points, the differences are exact and the plane is the data's.
+/// In f64 builds this is `Vec3` itself; in f32 it costs four widenings a solve.
+type Wide = glam::DVec3;
+
+#[cfg(not(feature = "f32"))]
+fn wide(v: Vec3) -> Wide {
+    v
+}
+#[cfg(feature = "f32")]
+fn wide(v: Vec3) -> Wide {
+    v.as_dvec3()
+}
+#[cfg(not(feature = "f32"))]
+fn narrow(v: Wide) -> Vec3 {
+    v
+}
+#[cfg(feature = "f32")]
+fn narrow(v: Wide) -> Vec3 {
+    v.as_vec3()
+}
+#[cfg(not(feature = "f32"))]
+fn real(x: f64) -> Real {
+    x
+}
+#[cfg(feature = "f32")]
+fn real(x: f64) -> Real {
+    x as Real
+}
+
 /// A point of the Minkowski difference with the two support points it came from (A frame).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub(crate) struct SupportPoint {
@@ -176,7 +210,7 @@ impl Simplex {
                 *p = old[k as usize];
             }
         }
-        self.lambda = sub.lambda;
+        self.lambda = sub.lambda.map(real);
         self.len = sub.len;
     }
 
@@ -245,6 +279,9 @@ pub(crate) fn gjk(pair: &Pair, cutoff: Real) -> Gjk {
     let mut s = Simplex::single(w0);
     let mut v = w0.w;
     let mut vv = v.length_squared();
+    // |v|² of the last solve, unrounded: the progress test below compares in f64, where a
+    // needle triangle's real but slight progress (10⁻⁷ of |v|², f32's rounding) still shows.
+    let mut vv_wide = wide(v).length_squared();
     let touch = pair.touch_tol();
     let cutoff = cutoff.max(0.0);
     let mut iterations = 0;
@@ -279,15 +316,16 @@ pub(crate) fn gjk(pair: &Pair, cutoff: Real) -> Gjk {
             break Status::Overlap;
         }
         let vv_new = sub.v.length_squared();
-        if vv_new.is_nan() || vv_new >= vv {
+        if vv_new.is_nan() || vv_new >= vv_wide {
             // In exact arithmetic |v| strictly decreases; when rounding says otherwise the
             // previous simplex is as close as this precision can get.
             s.len -= 1;
             break Status::Separated;
         }
         s.keep(&sub);
-        v = sub.v;
-        vv = vv_new;
+        v = narrow(sub.v);
+        vv = v.length_squared();
+        vv_wide = vv_new;
     };
     Gjk {
         status,
@@ -298,7 +336,7 @@ pub(crate) fn gjk(pair: &Pair, cutoff: Real) -> Gjk {
 
 /// True when `a` and `b` are both strictly positive or both strictly negative.
 #[inline]
-fn same_sign(a: Real, b: Real) -> bool {
+fn same_sign(a: f64, b: f64) -> bool {
     (a > 0.0 && b > 0.0) || (a < 0.0 && b < 0.0)
 }
 
@@ -307,13 +345,13 @@ fn same_sign(a: Real, b: Real) -> bool {
 #[derive(Debug, Clone, Copy)]
 struct Sub {
     idx: [u8; 4],
-    lambda: [Real; 4],
+    lambda: [f64; 4],
     len: usize,
-    v: Vec3,
+    v: Wide,
 }
 
 impl Sub {
-    fn single(i: u8, w: Vec3) -> Sub {
+    fn single(i: u8, w: Wide) -> Sub {
         Sub {
             idx: [i, 0, 0, 0],
             lambda: [1.0, 0.0, 0.0, 0.0],
@@ -326,7 +364,8 @@ impl Sub {
 /// The sub-simplex of `s` whose hull holds the point nearest the origin, with its weights,
 /// and that point.
 fn solve(s: &Simplex) -> Sub {
-    let w = s.pts.map(|p| p.w);
+    // a − b again, not `w`: exact in f64 from f32 supports.
+    let w = s.pts.map(|p| wide(p.a) - wide(p.b));
     match s.len {
         1 => Sub::single(0, w[0]),
         2 => segment(&w, 0, 1),
@@ -339,7 +378,7 @@ fn solve(s: &Simplex) -> Sub {
 /// u = −p·t/t·t, t = q − p; its weights are λ_q = −p·t/t·t and λ_p = q·t/t·t (they sum to
 /// (q − p)·t/t·t = 1). A weight ≤ 0 means the projection falls beyond the other end, whose
 /// vertex is then closest.
-fn segment(w: &[Vec3; 4], p: u8, q: u8) -> Sub {
+fn segment(w: &[Wide; 4], p: u8, q: u8) -> Sub {
     let (wp, wq) = (w[p as usize], w[q as usize]);
     let t = wq - wp;
     let lp = wq.dot(t);
@@ -368,14 +407,16 @@ fn segment(w: &[Vec3; 4], p: u8, q: u8) -> Sub {
 /// λ_a ∝ (b × c)·n, λ_b ∝ (c × a)·n, λ_c ∝ (a × b)·n, whose sum is
 /// ((b − a) × (c − a))·n = n·n. All of one sign: the projection is inside. Otherwise the
 /// nearest point lies on an edge facing away from a negative weight's vertex.
-fn triangle(w: &[Vec3; 4], t: [u8; 3]) -> Sub {
+fn triangle(w: &[Wide; 4], t: [u8; 3]) -> Sub {
     let (wa, wb, wc) = (w[t[0] as usize], w[t[1] as usize], w[t[2] as usize]);
-    let n = (wb - wa).cross(wc - wa);
+    let n = plane_normal(wa, wb, wc);
     let nn = n.length_squared();
+    // b × c = b × (c − b), and so on: an edge (short on a thin triangle) in place of a
+    // second far vertex keeps the products, and their rounding, small.
     let cof = [
-        wb.cross(wc).dot(n),
-        wc.cross(wa).dot(n),
-        wa.cross(wb).dot(n),
+        wb.cross(wc - wb).dot(n),
+        wc.cross(wa - wc).dot(n),
+        wa.cross(wb - wa).dot(n),
     ];
     let det = cof[0] + cof[1] + cof[2];
     let inside = nn > 0.0 && cof.iter().all(|&k| same_sign(det, k));
@@ -402,18 +443,41 @@ fn triangle(w: &[Vec3; 4], t: [u8; 3]) -> Sub {
     best.unwrap_or(Sub::single(t[0], wa))
 }
 
+/// (b − a) × (c − a), which equals (c − b) × (a − b) and (a − c) × (b − c), taken about
+/// the vertex opposite the longest edge. Crossing the two long edges of a thin triangle
+/// cancels products of their lengths down to its area, and the normal keeps only the
+/// rounding left over (a 1 cm by 28 m triangle loses about three more digits than the
+/// short edge and one long one do).
+fn plane_normal(a: Wide, b: Wide, c: Wide) -> Wide {
+    let (ab, bc, ca) = (b - a, c - b, a - c);
+    let (lab, lbc, lca) = (
+        ab.length_squared(),
+        bc.length_squared(),
+        ca.length_squared(),
+    );
+    if lbc >= lab && lbc >= lca {
+        ab.cross(-ca)
+    } else if lca >= lab {
+        bc.cross(-ab)
+    } else {
+        ca.cross(-bc)
+    }
+}
+
 /// Tetrahedron of the four points of `w`: the weight of vertex k is the signed volume of
 /// the tetrahedron with the origin in its place over the whole signed volume (their sum).
 /// All of one sign: the origin is inside. Otherwise descend into each face whose opposite
 /// weight is not of that sign.
-fn tetrahedron(w: &[Vec3; 4]) -> Sub {
-    let vol = |a: Vec3, b: Vec3, c: Vec3, d: Vec3| (b - a).dot((c - a).cross(d - a));
-    let o = Vec3::ZERO;
+fn tetrahedron(w: &[Wide; 4]) -> Sub {
+    // The volume with the origin in place of one vertex, a · ((b − a) × (c − a)) for the
+    // face abc, with that face's normal taken as `triangle` takes it (an alternating form:
+    // the second and fourth change sign with the permutation that brings the origin first).
+    let vol = |a: Wide, b: Wide, c: Wide| a.dot(plane_normal(a, b, c));
     let cof = [
-        vol(o, w[1], w[2], w[3]),
-        vol(w[0], o, w[2], w[3]),
-        vol(w[0], w[1], o, w[3]),
-        vol(w[0], w[1], w[2], o),
+        vol(w[1], w[2], w[3]),
+        -vol(w[0], w[2], w[3]),
+        vol(w[0], w[1], w[3]),
+        -vol(w[0], w[1], w[2]),
     ];
     let det = cof[0] + cof[1] + cof[2] + cof[3];
     if cof.iter().all(|&k| same_sign(det, k)) {
@@ -421,7 +485,7 @@ fn tetrahedron(w: &[Vec3; 4]) -> Sub {
             idx: [0, 1, 2, 3],
             lambda: cof.map(|k| k / det),
             len: 4,
-            v: Vec3::ZERO,
+            v: Wide::ZERO,
         };
     }
     let mut best: Option<Sub> = None;
@@ -443,57 +507,57 @@ mod tests {
 
     #[test]
     fn segment_interior_and_ends() {
-        let two = |p: Vec3, q: Vec3| segment(&[p, q, Vec3::ZERO, Vec3::ZERO], 0, 1);
-        let s = two(Vec3::new(-1.0, 1.0, 0.0), Vec3::new(3.0, 1.0, 0.0));
+        let two = |p: Wide, q: Wide| segment(&[p, q, Wide::ZERO, Wide::ZERO], 0, 1);
+        let s = two(Wide::new(-1.0, 1.0, 0.0), Wide::new(3.0, 1.0, 0.0));
         assert_eq!(s.len, 2);
-        assert!((s.v - Vec3::new(0.0, 1.0, 0.0)).length() < 1e-6);
-        let s = two(Vec3::new(1.0, 1.0, 0.0), Vec3::new(3.0, 1.0, 0.0));
+        assert!((s.v - Wide::new(0.0, 1.0, 0.0)).length() < 1e-6);
+        let s = two(Wide::new(1.0, 1.0, 0.0), Wide::new(3.0, 1.0, 0.0));
         assert_eq!(s.len, 1);
-        assert_eq!(s.v, Vec3::new(1.0, 1.0, 0.0));
+        assert_eq!(s.v, Wide::new(1.0, 1.0, 0.0));
         // Degenerate: both points equal.
-        assert_eq!(two(Vec3::ONE, Vec3::ONE).len, 1);
+        assert_eq!(two(Wide::ONE, Wide::ONE).len, 1);
     }
 
     #[test]
     fn triangle_regions() {
         let t = [
-            Vec3::new(-1.0, -1.0, 2.0),
-            Vec3::new(2.0, -1.0, 2.0),
-            Vec3::new(-1.0, 2.0, 2.0),
+            Wide::new(-1.0, -1.0, 2.0),
+            Wide::new(2.0, -1.0, 2.0),
+            Wide::new(-1.0, 2.0, 2.0),
         ];
-        let three = |a: Vec3, b: Vec3, c: Vec3| triangle(&[a, b, c, Vec3::ZERO], [0, 1, 2]);
+        let three = |a: Wide, b: Wide, c: Wide| triangle(&[a, b, c, Wide::ZERO], [0, 1, 2]);
         let s = three(t[0], t[1], t[2]);
         assert_eq!(s.len, 3);
-        assert!((s.v - Vec3::new(0.0, 0.0, 2.0)).length() < 1e-6);
+        assert!((s.v - Wide::new(0.0, 0.0, 2.0)).length() < 1e-6);
         // Shifted so the origin projects beyond the edge t0–t1.
-        let off = Vec3::new(0.0, 3.0, 0.0);
+        let off = Wide::new(0.0, 3.0, 0.0);
         let s = three(t[0] + off, t[1] + off, t[2] + off);
         assert_eq!(s.len, 2);
-        assert!((s.v - Vec3::new(0.0, 2.0, 2.0)).length() < 1e-6);
+        assert!((s.v - Wide::new(0.0, 2.0, 2.0)).length() < 1e-6);
         // Collinear: no NaN, nearest vertex.
-        let s = three(Vec3::X, Vec3::X * 2.0, Vec3::X * 3.0);
-        assert_eq!(s.v, Vec3::X);
+        let s = three(Wide::X, Wide::X * 2.0, Wide::X * 3.0);
+        assert_eq!(s.v, Wide::X);
     }
 
     #[test]
     fn tetrahedron_inside_and_outside() {
         let t = [
-            Vec3::new(1.0, 0.0, -1.0),
-            Vec3::new(-1.0, 1.0, -1.0),
-            Vec3::new(-1.0, -1.0, -1.0),
-            Vec3::new(0.0, 0.0, 1.0),
+            Wide::new(1.0, 0.0, -1.0),
+            Wide::new(-1.0, 1.0, -1.0),
+            Wide::new(-1.0, -1.0, -1.0),
+            Wide::new(0.0, 0.0, 1.0),
         ];
         let s = tetrahedron(&t);
         assert_eq!(s.len, 4);
-        assert_eq!(s.v, Vec3::ZERO);
-        let sum: Real = s.lambda.iter().sum();
+        assert_eq!(s.v, Wide::ZERO);
+        let sum: f64 = s.lambda.iter().sum();
         assert!((sum - 1.0).abs() < 1e-6);
-        let off = Vec3::new(0.0, 0.0, 2.0);
+        let off = Wide::new(0.0, 0.0, 2.0);
         let s = tetrahedron(&t.map(|p| p + off));
         assert_eq!(s.len, 3);
-        assert!((s.v - Vec3::new(0.0, 0.0, 1.0)).length() < 1e-6);
+        assert!((s.v - Wide::new(0.0, 0.0, 1.0)).length() < 1e-6);
         // Flat: no NaN.
-        let flat = [Vec3::X, Vec3::Y, -Vec3::X, -Vec3::Y].map(|p| p + off);
+        let flat = [Wide::X, Wide::Y, -Wide::X, -Wide::Y].map(|p| p + off);
         assert!((tetrahedron(&flat).v - off).length() < 1e-6);
     }
 

@@ -235,7 +235,7 @@ fn resolve(
                     &mut dirs,
                 );
                 cylinder_axes(&pair.b, &pair.rel, &[Vec3::ZERO, p.point_a], &mut dirs);
-                return Some(best_axis(pair, found, &dirs));
+                return Some(opposite_the_sharp_side(pair, best_axis(pair, found, &dirs)));
             }
             let start = Deepest {
                 normal: Vec3::X,
@@ -258,6 +258,37 @@ fn resolve(
             Some(best_axis(pair, start, &dirs))
         }
     }
+}
+
+/// EPA's witnesses are its last face's weights applied to support points, so each sits on
+/// its core's surface only as well as the face fits it. Where one core's support along the
+/// normal is a single point (a rim, a vertex, a ball) and the other's is a line or a face (a
+/// cylinder's side, a lying capsule's segment), the single point is the contact and the
+/// other witness is anywhere on its feature: a cylinder's rim sunk 14 mm into another's side
+/// had the side's witness 2.3 cm along it (f64), and in f32 in another place under each
+/// rigid motion of the pair. That witness is put opposite the single point instead.
+fn opposite_the_sharp_side(pair: &Pair, mut d: Deepest) -> Deepest {
+    let n = d.normal;
+    let flat_a = spread_support(|s| pair.a.core_support(s), n, pair.scale);
+    let flat_b = spread_support(|s| pair.support_b(s), -n, pair.scale);
+    if flat_b && !flat_a {
+        d.point_b = d.point_a + n * d.separation;
+    } else if flat_a && !flat_b {
+        d.point_a = d.point_b - n * d.separation;
+    }
+    d
+}
+
+/// Whether the support along `n` is a line or a face rather than a point: tilting `n` by
+/// 10⁻³ rad moves a curved surface's support by at most 10⁻³ of its radius (below `scale`),
+/// but jumps across a flat feature, by its size.
+fn spread_support(support: impl Fn(Vec3) -> Vec3, n: Vec3, scale: Real) -> bool {
+    const TILT: Real = 1e-3;
+    let p = support(n);
+    let [t1, t2] = crate::math::orthonormal_basis(n);
+    [t1, -t1, t2, -t2]
+        .iter()
+        .any(|&t| (support(n + t * TILT) - p).length() > 10.0 * TILT * scale)
 }
 
 /// A cylinder's axis and the radial directions from its axis through `points` (working

@@ -190,3 +190,40 @@ fn capsule_lying_on_a_triangle() {
         assert!((p.point_b.z.abs() - 0.5).abs() < EPS);
     }
 }
+
+/// A small capsule just over or into a large box's top face, at many orientations: the
+/// distance is the lower end's height less the radius. On a box 40 m across, f32's GJK
+/// once stopped at the capsule's middle, 3 mm off (its simplex solved in f32, see
+/// `gjk::Wide`); the error now stays at the rounding of the box's corners in the capsule's
+/// frame, a few epsilons of their distance (measured: 68 µm at 141 m in f32, 2·10⁻¹⁴ m in
+/// f64; 1 µm for the 1 m box in f32, GJK's relative tolerance).
+#[test]
+fn small_capsule_over_a_large_box() {
+    let (r, hh) = (0.005, 0.005);
+    let a = Convex::Capsule {
+        radius: r,
+        half_height: hh,
+    };
+    for half in [0.5, 5.0, 20.0, 100.0] {
+        let b = Convex::Box {
+            half_extents: Vec3::new(half, 0.005, half),
+        };
+        let pb = Pose::new(Vec3::new(0.0, -0.005, 0.0), crate::math::Quat::IDENTITY);
+        let allowed = 8.0 * crate::math::EPSILON * (half * Real::sqrt(2.0) + 1.0);
+        for k in 0..400 {
+            let k = k as Real;
+            let axis = Vec3::new((1.3 * k).sin(), (0.7 * k).cos(), (2.1 * k).sin() + 0.1);
+            let q = crate::math::Quat::from_axis_angle(axis.normalize(), 0.37 * k);
+            let height = 0.011 * ((0.9 * k).sin() * 0.5 + 0.5) - 0.002;
+            let centre = Vec3::new(0.3 * (1.1 * k).sin(), height, 0.3 * (1.7 * k).cos());
+            let c = closest_points(&a, &Pose::new(centre, q), &b, &pb);
+            let lowest = centre.y - (q * Vec3::Y).y.abs() * hh - r;
+            let err = (c.distance - lowest).abs();
+            assert!(
+                err < allowed,
+                "box {half}, case {k}: {} for {lowest}",
+                c.distance
+            );
+        }
+    }
+}
