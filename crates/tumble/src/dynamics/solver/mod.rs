@@ -23,7 +23,6 @@ mod contact_wide;
 mod joint;
 mod lanes;
 mod mass_ratio;
-mod overlap;
 mod restitution;
 mod rows;
 mod settings;
@@ -83,9 +82,6 @@ pub(crate) struct Solver {
     split_kick: Vec<bool>,
     wrench: Vec<Wrench>,
     motions: Vec<Motion>,
-    /// The step's points that start deeper than the slop (see `overlap`), and scratch.
-    deep: Vec<overlap::Deep>,
-    overlap: overlap::Scratch,
 }
 
 impl Solver {
@@ -115,11 +111,7 @@ impl Solver {
             (bodies, world_bodies),
             contacts,
             input.ghosts,
-            (
-                input.scales.linear_slop,
-                gravity,
-                overlap::spring(input.settings, time),
-            ),
+            (input.scales.linear_slop, gravity),
         );
         self.prepare_joints(bodies, world_bodies, input.joints, input.joint_bodies);
         let passes = joint_passes(input.settings, time);
@@ -143,14 +135,6 @@ impl Solver {
                 time.h,
                 input.scales.restitution_threshold,
             ),
-        );
-        overlap::push_apart(
-            &self.constraints,
-            &self.points,
-            &mut self.deep,
-            (&mut bodies.sims, &mut bodies.states),
-            input.scales.max_push * time.dt,
-            &mut self.overlap,
         );
         for c in &self.constraints {
             c.store_impulses(&self.points, &mut contacts[c.contact]);
@@ -270,11 +254,10 @@ impl Solver {
         (bodies, world_bodies): (&SolverBodies, &[Body]),
         contacts: &[Contact],
         ghosts: &[bool],
-        (slop, gravity, spring): (Real, Vec3, Real),
+        (slop, gravity): (Real, Vec3),
     ) {
         self.constraints.clear();
         self.points.clear();
-        self.deep.clear();
         let order = self.colour_order(&bodies.sims, contacts, ghosts);
         let falls = |s: &BodySim| {
             if s.moves {
@@ -311,7 +294,6 @@ impl Solver {
                 gravity: (!(sa.moves && sb.moves) || gravity == Vec3::ZERO)
                     .then(|| (falls(sa), falls(sb))),
             };
-            let first = self.points.hot.len();
             self.constraints.push(ContactConstraint::prepare(
                 (i, colour),
                 c,
@@ -319,16 +301,6 @@ impl Solver {
                 (&bodies.sims, &bodies.states),
                 &mut self.points,
             ));
-            let k = self.constraints.len() - 1;
-            for (j, mp) in c.manifold.points().iter().enumerate() {
-                let p = &mut self.points.hot[first + j];
-                if let Some(deep) =
-                    overlap::Deep::find((k, first + j), mp.separation, p, (slop, spring))
-                {
-                    p.separation = -deep.depth;
-                    self.deep.push(deep);
-                }
-            }
         }
         self.points
             .group_lanes(&self.constraints, self.heavy_contacts);
