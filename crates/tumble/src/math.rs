@@ -41,6 +41,48 @@ mod precision {
 
 pub use precision::*;
 
+/// Conversions between `Real` and f64, for the computations that need f64 whatever `Real`
+/// is (the hull builder, GJK's simplex).
+#[cfg(not(feature = "f32"))]
+pub(crate) mod wide {
+    use crate::math::{Mat3, Real, Vec3};
+    use glam::{DMat3, DVec3};
+
+    pub fn vec(v: Vec3) -> DVec3 {
+        v
+    }
+    pub fn scalar(x: Real) -> f64 {
+        x
+    }
+    pub fn to_vec(v: DVec3) -> Vec3 {
+        v
+    }
+    pub fn to_mat(m: DMat3) -> Mat3 {
+        m
+    }
+}
+
+/// Conversions between `Real` and f64, for the computations that need f64 whatever `Real`
+/// is (the hull builder, GJK's simplex).
+#[cfg(feature = "f32")]
+pub(crate) mod wide {
+    use crate::math::{Mat3, Real, Vec3};
+    use glam::{DMat3, DVec3};
+
+    pub fn vec(v: Vec3) -> DVec3 {
+        v.as_dvec3()
+    }
+    pub fn scalar(x: Real) -> f64 {
+        f64::from(x)
+    }
+    pub fn to_vec(v: DVec3) -> Vec3 {
+        v.as_vec3()
+    }
+    pub fn to_mat(m: DMat3) -> Mat3 {
+        m.as_mat3()
+    }
+}
+
 /// Converts an `f64` literal or measurement into `Real` (a no-op in the default build).
 #[inline]
 pub fn real(x: f64) -> Real {

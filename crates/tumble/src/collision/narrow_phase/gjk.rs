@@ -22,7 +22,8 @@
 
 use crate::collision::geometry::Pose;
 use crate::collision::shape::Convex;
-use crate::math::{Quat, Real, Vec3, EPSILON};
+use crate::math::wide;
+use crate::math::{real, Quat, Real, Vec3, EPSILON};
 
 /// GJK iterations. A pair of polytopes converges exactly (a support point repeats) in a
 /// handful of steps; a curved core (a cylinder's rim against another) converges linearly,
@@ -54,31 +55,6 @@ const TOUCH_ULPS: Real = 100.0;
 /// f64 from the f32 support points, the differences are exact and the plane is the data's.
 /// In f64 builds this is `Vec3` itself; in f32 it costs four widenings a solve.
 type Wide = glam::DVec3;
-
-#[cfg(not(feature = "f32"))]
-fn wide(v: Vec3) -> Wide {
-    v
-}
-#[cfg(feature = "f32")]
-fn wide(v: Vec3) -> Wide {
-    v.as_dvec3()
-}
-#[cfg(not(feature = "f32"))]
-fn narrow(v: Wide) -> Vec3 {
-    v
-}
-#[cfg(feature = "f32")]
-fn narrow(v: Wide) -> Vec3 {
-    v.as_vec3()
-}
-#[cfg(not(feature = "f32"))]
-fn real(x: f64) -> Real {
-    x
-}
-#[cfg(feature = "f32")]
-fn real(x: f64) -> Real {
-    x as Real
-}
 
 /// A point of the Minkowski difference with the two support points it came from (A frame).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -281,7 +257,7 @@ pub(crate) fn gjk(pair: &Pair, cutoff: Real) -> Gjk {
     let mut vv = v.length_squared();
     // |v|² of the last solve, unrounded: the progress test below compares in f64, where a
     // needle triangle's real but slight progress (10⁻⁷ of |v|², f32's rounding) still shows.
-    let mut vv_wide = wide(v).length_squared();
+    let mut vv_wide = wide::vec(v).length_squared();
     let touch = pair.touch_tol();
     let cutoff = cutoff.max(0.0);
     let mut iterations = 0;
@@ -323,7 +299,7 @@ pub(crate) fn gjk(pair: &Pair, cutoff: Real) -> Gjk {
             break Status::Separated;
         }
         s.keep(&sub);
-        v = narrow(sub.v);
+        v = wide::to_vec(sub.v);
         vv = v.length_squared();
         vv_wide = vv_new;
     };
@@ -365,7 +341,7 @@ impl Sub {
 /// and that point.
 fn solve(s: &Simplex) -> Sub {
     // a − b again, not `w`: exact in f64 from f32 supports.
-    let w = s.pts.map(|p| wide(p.a) - wide(p.b));
+    let w = s.pts.map(|p| wide::vec(p.a) - wide::vec(p.b));
     match s.len {
         1 => Sub::single(0, w[0]),
         2 => segment(&w, 0, 1),

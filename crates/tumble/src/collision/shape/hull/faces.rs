@@ -2,7 +2,8 @@
 //! corners (vertices on three or more faces) that a rebuild keeps, and the public hull
 //! assembled from them, with each face's plane and the feature edges between faces.
 
-use super::{tri_cross, tri_plane, wide, ConvexHull, NONE};
+use super::{tri_cross, tri_plane, ConvexHull, NONE};
+use crate::math::wide;
 use crate::math::{real, Real, Vec3};
 use glam::DVec3;
 use std::collections::{BTreeMap, BTreeSet};

@@ -4,8 +4,9 @@
 //! first moment and covariance; the apex at an interior point keeps the terms small so they
 //! cancel little. Accumulated in f64 whatever `Real` is.
 
-use super::{wide, ConvexHull};
+use super::ConvexHull;
 use crate::collision::shape::MassProperties;
+use crate::math::wide;
 use crate::math::{real, Real};
 use glam::{DMat3, DVec3};
 

@@ -22,7 +22,7 @@ mod mass;
 mod tests;
 
 use crate::error::{Error, Result};
-use crate::math::{Real, Vec3, EPSILON};
+use crate::math::{wide, Real, Vec3, EPSILON};
 use build::build;
 use faces::{assemble, corners, merge_coplanar, Polygon};
 use glam::DVec3;
@@ -128,46 +128,6 @@ impl ConvexHull {
             }
         }
         best
-    }
-}
-
-/// Conversions between `Real` and the f64 the hull computes in.
-#[cfg(not(feature = "f32"))]
-mod wide {
-    use crate::math::{Mat3, Real, Vec3};
-    use glam::{DMat3, DVec3};
-
-    pub fn vec(v: Vec3) -> DVec3 {
-        v
-    }
-    pub fn scalar(x: Real) -> f64 {
-        x
-    }
-    pub fn to_vec(v: DVec3) -> Vec3 {
-        v
-    }
-    pub fn to_mat(m: DMat3) -> Mat3 {
-        m
-    }
-}
-
-/// Conversions between `Real` and the f64 the hull computes in.
-#[cfg(feature = "f32")]
-mod wide {
-    use crate::math::{Mat3, Real, Vec3};
-    use glam::{DMat3, DVec3};
-
-    pub fn vec(v: Vec3) -> DVec3 {
-        v.as_dvec3()
-    }
-    pub fn scalar(x: Real) -> f64 {
-        f64::from(x)
-    }
-    pub fn to_vec(v: DVec3) -> Vec3 {
-        v.as_vec3()
-    }
-    pub fn to_mat(m: DMat3) -> Mat3 {
-        m.as_mat3()
     }
 }
 
