@@ -104,8 +104,10 @@ fn bodies_created_at_one_point_keep_contacts_in_proportion_to_their_number() {
                 // In a cloud some pairs overlap by less than a quarter of the thinner
                 // body (a 4 cm slab against one 3 cm above it), are not counted, and are
                 // kept while one body is not yet crowded: measured, up to twice as many.
+                // Overlap recovery makes a cloud of the one-point pile after its first
+                // step (400 slabs: 3,907 contacts at step 2, against 3,608 for one point).
                 let mut bound = (per_body as usize + 4) * (n + 1) + n;
-                if spread > 0.0 {
+                if spread > 0.0 || step > 0 {
                     bound *= 2;
                 }
                 assert!(kept <= bound, "{name} step {step}: {kept} > {bound}");

@@ -59,6 +59,20 @@ pub struct ContactPoint {
 /// Most points a manifold holds: four span any flat contact patch stably.
 pub const MAX_MANIFOLD_POINTS: usize = 4;
 
+/// Whether a pair's depth is its own to recover from (see `dynamics::solver::overlap`):
+/// only a pair found deeper than its motion explains, when its contact was new, was
+/// created overlapping; it recovers until no point of it is deep any more.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(crate) enum Overlap {
+    /// The contact's first step: not yet looked at.
+    #[default]
+    New,
+    /// Found overlapping and not yet pushed out.
+    Recovering,
+    /// Met by motion, or pushed out: the solver alone resolves its depth.
+    Clear,
+}
+
 /// The contact between two (sub-)shapes: one normal and up to four points.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Manifold {
@@ -72,6 +86,8 @@ pub struct Manifold {
     /// frame (N·m·s): rolling resistance about the tangents, torsional friction about the
     /// normal. Zero unless a body of the pair has either; kept to warm start the next step.
     pub angular_impulse: Vec3,
+    /// Whether the pair was found interpenetrating, kept from step to step.
+    pub(crate) overlap: Overlap,
     points: [ContactPoint; MAX_MANIFOLD_POINTS],
     count: u8,
 }

@@ -20,6 +20,7 @@ mod sphere;
 
 pub(crate) use convex::within;
 pub use convex::{closest_points, ClosestPoints};
+pub(crate) use manifold::Overlap;
 pub use manifold::{
     feature_id, reduce, swap_feature, Candidate, ContactPoint, FeatureId, Manifold,
     MAX_MANIFOLD_POINTS,

@@ -23,6 +23,7 @@ mod contact_wide;
 mod joint;
 mod lanes;
 mod mass_ratio;
+mod overlap;
 mod restitution;
 mod rows;
 mod settings;
@@ -39,6 +40,7 @@ use contact::{BiasRule, ContactConstraint, PairData, Points};
 use joint::{JointConstraint, JointPass};
 
 use crate::collision::contact::Contact;
+use crate::collision::narrow_phase::Overlap;
 use crate::dynamics::body::Motion;
 use crate::dynamics::body::{Body, BodyKind};
 use crate::dynamics::force::Wrench;
@@ -82,6 +84,9 @@ pub(crate) struct Solver {
     split_kick: Vec<bool>,
     wrench: Vec<Wrench>,
     motions: Vec<Motion>,
+    /// The step's points that start deeper than the slop (see `overlap`), and scratch.
+    deep: Vec<overlap::Deep>,
+    overlap: overlap::Scratch,
 }
 
 impl Solver {
@@ -111,7 +116,11 @@ impl Solver {
             (bodies, world_bodies),
             contacts,
             input.ghosts,
-            (input.scales.linear_slop, gravity),
+            (
+                input.scales.linear_slop,
+                gravity,
+                overlap::Allowance::new(input.settings, time, input.scales.linear_slop),
+            ),
         );
         self.prepare_joints(bodies, world_bodies, input.joints, input.joint_bodies);
         let passes = joint_passes(input.settings, time);
@@ -136,8 +145,21 @@ impl Solver {
                 input.scales.restitution_threshold,
             ),
         );
+        overlap::push_apart(
+            &self.constraints,
+            &self.points,
+            &mut self.deep,
+            (&mut bodies.sims, &mut bodies.states),
+            input.scales.max_push * time.dt,
+            &mut self.overlap,
+        );
         for c in &self.constraints {
             c.store_impulses(&self.points, &mut contacts[c.contact]);
+            contacts[c.contact].manifold.overlap = Overlap::Clear;
+        }
+        for d in self.deep.iter().filter(|d| !d.guard) {
+            let c = &self.constraints[d.constraint as usize];
+            contacts[c.contact].manifold.overlap = Overlap::Recovering;
         }
         for ((sim, state), body) in bodies
             .sims
@@ -254,10 +276,11 @@ impl Solver {
         (bodies, world_bodies): (&SolverBodies, &[Body]),
         contacts: &[Contact],
         ghosts: &[bool],
-        (slop, gravity): (Real, Vec3),
+        (slop, gravity, allow): (Real, Vec3, overlap::Allowance),
     ) {
         self.constraints.clear();
         self.points.clear();
+        self.deep.clear();
         let order = self.colour_order(&bodies.sims, contacts, ghosts);
         let falls = |s: &BodySim| {
             if s.moves {
@@ -294,6 +317,7 @@ impl Solver {
                 gravity: (!(sa.moves && sb.moves) || gravity == Vec3::ZERO)
                     .then(|| (falls(sa), falls(sb))),
             };
+            let first = self.points.hot.len();
             self.constraints.push(ContactConstraint::prepare(
                 (i, colour),
                 c,
@@ -301,6 +325,19 @@ impl Solver {
                 (&bodies.sims, &bodies.states),
                 &mut self.points,
             ));
+            let k = self.constraints.len() - 1;
+            if c.manifold.overlap == Overlap::Clear {
+                continue;
+            }
+            for (j, mp) in c.manifold.points().iter().enumerate() {
+                let start_velocity = self.points.cold[first + j].start_velocity;
+                let p = &mut self.points.hot[first + j];
+                let at = (mp.separation, start_velocity);
+                if let Some(deep) = overlap::Deep::find((k, first + j), at, p, &allow) {
+                    p.separation = -deep.depth;
+                    self.deep.push(deep);
+                }
+            }
         }
         self.points
             .group_lanes(&self.constraints, self.heavy_contacts);

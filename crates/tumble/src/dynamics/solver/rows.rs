@@ -245,7 +245,12 @@ impl Point {
     /// The point's separation now, from the motion of states `a`, `b` since the step
     /// began (their `dp`, `dr`).
     pub fn separation_now(&self, n: Vec3, a: &BodyState, b: &BodyState) -> Real {
-        Moved::along(n, &Motion::of(a, b)).gap(self.separation, self.ra, self.rb, self.lever)
+        self.separation_from(self.separation, n, a, b)
+    }
+
+    /// [`Point::separation_now`] of a point that started the step `start` apart.
+    pub fn separation_from(&self, start: Real, n: Vec3, a: &BodyState, b: &BodyState) -> Real {
+        Moved::along(n, &Motion::of(a, b)).gap(start, self.ra, self.rb, self.lever)
     }
 }
 
