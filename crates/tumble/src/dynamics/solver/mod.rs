@@ -84,7 +84,8 @@ pub(crate) struct Solver {
     split_kick: Vec<bool>,
     wrench: Vec<Wrench>,
     motions: Vec<Motion>,
-    /// The step's points that start deeper than the slop (see `overlap`), and scratch.
+    /// The step's points of overlapping pairs deeper than allowed, with their guards
+    /// (see `overlap`), and scratch.
     deep: Vec<overlap::Deep>,
     overlap: overlap::Scratch,
 }
