@@ -226,8 +226,8 @@ fn stop_approach(
 }
 
 /// Adds to `deep` the other points of the bodies it pushes, as guards: their depth now
-/// (or the slop) is their target, so the pass may not push a body further into a
-/// neighbour. Without them, of five 1 m cubes created half inside each other, the
+/// (or touching, for points still apart) is their target, so the pass may not push a
+/// body further into a neighbour. Without them, of five 1 m cubes created half inside each other, the
 /// bottom one, pushed up, went into the third (which it had just touched), whose
 /// contact the solver then resolved in velocity: the column's top left at 1.1 m/s.
 fn add_guards(
