@@ -34,12 +34,15 @@ pub struct Inner {
 /// substeps=4, iterations=1, contact_hertz=60.0, contact_damping_ratio=10.0,
 /// joint_hertz=1000.0, joint_damping_ratio=0.5, baumgarte=0.2, length_unit=1.0,
 /// sleep=True, max_speed=None, max_angular_speed=None, max_contacts=None,
-/// max_contacts_per_body=None). SI units throughout; quaternions are [x, y, z, w].
+/// max_contacts_per_body=None, max_push_speed=None). SI units throughout; quaternions
+/// are [x, y, z, w].
 /// `max_speed` (m/s) and `max_angular_speed` (rad/s) bound every body's speed (defaults
 /// 1e4·length_unit and 1e5): a step that exceeds them, or whose result is not finite, is
 /// undone and raises SimulationError; so is one needing more than `max_contacts` contact
 /// manifolds (default 1,048,576). `max_contacts_per_body` (default 16) is how many other
 /// bodies a body may be sunk into before two such crowded bodies are no longer paired.
+/// `max_push_speed` (m/s, default 3·length_unit) is the fastest contacts push
+/// overlapping bodies apart.
 #[pyclass(module = "tumble", name = "World", frozen)]
 pub struct PyWorld {
     // A Mutex rather than PyO3's borrow flag: the engine's World is Send but not Sync
@@ -312,7 +315,8 @@ impl PyWorld {
         solver = "soft_step".to_string(), substeps = 4, iterations = 1, contact_hertz = 60.0,
         contact_damping_ratio = 10.0, joint_hertz = 1000.0, joint_damping_ratio = 0.5,
         baumgarte = 0.2, length_unit = 1.0, sleep = true, max_speed = None,
-        max_angular_speed = None, max_contacts = None, max_contacts_per_body = None))]
+        max_angular_speed = None, max_contacts = None, max_contacts_per_body = None,
+        max_push_speed = None))]
     #[allow(clippy::too_many_arguments)]
     fn py_new(
         gravity: Option<&Bound<'_, PyAny>>,
@@ -331,6 +335,7 @@ impl PyWorld {
         max_angular_speed: Option<f64>,
         max_contacts: Option<i64>,
         max_contacts_per_body: Option<i64>,
+        max_push_speed: Option<f64>,
     ) -> PyResult<Self> {
         let settings = PySolverSettings {
             kind: solver,
@@ -350,6 +355,7 @@ impl PyWorld {
             sleep,
             limits: speed_limits(max_speed, max_angular_speed, length_unit),
             contact_limits: contact_limits(max_contacts, max_contacts_per_body)?,
+            max_push_speed: max_push_speed.map(real),
         };
         let world = World::try_new(&def).map_err(engine)?;
         Ok(PyWorld::new_inner(Inner {
@@ -769,6 +775,20 @@ impl PyWorld {
             ..g.world.contact_limits()
         };
         g.world.set_contact_limits(limits).map_err(engine)
+    }
+
+    /// The fastest contacts push overlapping bodies apart (m/s; default 3 times
+    /// `length_unit`), by depth correction and by the recovery of bodies created inside
+    /// each other. Assignable (> 0).
+    #[getter]
+    fn max_push_speed(&self) -> PyResult<f64> {
+        Ok(wide(self.lock()?.world.max_push_speed()))
+    }
+
+    #[setter]
+    fn set_max_push_speed(&self, value: f64) -> PyResult<()> {
+        let mut g = self.lock()?;
+        g.world.set_max_push_speed(real(value)).map_err(engine)
     }
 
     /// Speculative contact distance (m): gaps narrower than this count as contacts.

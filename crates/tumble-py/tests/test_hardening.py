@@ -406,3 +406,31 @@ def test_contact_limits_are_whole_numbers_from_one(field, value, rule):
     with pytest.raises(ValueError, match=f"^{field}: must be {rule}$"):
         setattr(world, field, value)
     assert (world.max_contacts, world.max_contacts_per_body) == (1 << 20, 16)
+
+
+@pytest.mark.parametrize("value", [0.0, -1.0, float("nan"), float("inf")])
+def test_a_bad_push_out_speed_is_refused_and_changes_nothing(value):
+    rule = "must be a finite number" if not np.isfinite(value) else "must be > 0"
+    with pytest.raises(ValueError, match=f"^max_push_speed: {rule}$"):
+        tumble.World(max_push_speed=value)
+    world = tumble.World(max_push_speed=0.5)
+    with pytest.raises(ValueError, match=f"^max_push_speed: {rule}$"):
+        world.max_push_speed = value
+    assert world.max_push_speed == 0.5
+
+
+def test_the_push_out_speed_bounds_how_fast_overlapping_boxes_part():
+    # Two 1 m cubes half inside each other, no gravity: with the cap at 0.5 m/s they part
+    # at most 0.5 m/s × dt per step (the default, 3 m/s × length_unit, would take 10 steps).
+    assert tumble.World().max_push_speed == 3.0
+    assert tumble.World(length_unit=0.01).max_push_speed == pytest.approx(0.03)
+    world = tumble.World(gravity=(0, 0, 0), sleep=False, max_push_speed=0.5)
+    a = world.add_body(tumble.Box((0.5, 0.5, 0.5)), position=(0, -0.25, 0))
+    b = world.add_body(tumble.Box((0.5, 0.5, 0.5)), position=(0, 0.25, 0))
+    dt = 1 / 60
+    gaps = [0.5]
+    for _ in range(90):
+        world.step(dt)
+        gaps.append(b.position[1] - a.position[1])
+    assert max(np.diff(gaps)) <= 0.5 * dt * 1.001
+    assert gaps[-1] > 0.994

@@ -41,7 +41,7 @@ pub use body::check_name;
 
 use reader::{Node, Obj};
 
-const TOP_KEYS: [&str; 22] = [
+const TOP_KEYS: [&str; 23] = [
     "name",
     "description",
     "gravity",
@@ -64,6 +64,7 @@ const TOP_KEYS: [&str; 22] = [
     "max_angular_speed",
     "max_contacts",
     "max_contacts_per_body",
+    "max_push_speed",
 ];
 
 /// The most `substeps` and `iterations` a scene or the command line may ask for.
@@ -182,6 +183,7 @@ fn build(root: &Node<'_>) -> Result<Scene> {
         sleep: obj.bool("sleep")?.unwrap_or(true),
         limits: speed_limits(&obj, length_unit)?,
         contact_limits: contact_limits(&obj)?,
+        max_push_speed: obj.real("max_push_speed")?,
     };
     let dt = obj.real("dt")?.unwrap_or(DEFAULT_DT);
     let duration = obj.real("duration")?.unwrap_or(DEFAULT_DURATION);

@@ -40,7 +40,7 @@ fn misspelt_keys_are_refused_with_the_allowed_ones() {
         "gravityy: unknown key (expected one of: name, description, gravity, dt, duration, \
          integrator, bodies, forces, joints, solver, substeps, iterations, contact_hertz, \
          contact_damping_ratio, joint_hertz, joint_damping_ratio, length_unit, sleep, max_speed, \
-         max_angular_speed, max_contacts, max_contacts_per_body)"
+         max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed)"
     );
     assert_eq!(
         error(&one_body(r#""velocty": [1, 0, 0]"#)),
@@ -337,7 +337,7 @@ fn user_text_cannot_break_the_line() {
         "du\\nration: unknown key (expected one of: name, description, gravity, dt, duration, \
          integrator, bodies, forces, joints, solver, substeps, iterations, contact_hertz, \
          contact_damping_ratio, joint_hertz, joint_damping_ratio, length_unit, sleep, max_speed, \
-         max_angular_speed, max_contacts, max_contacts_per_body)"
+         max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed)"
     );
     assert_eq!(error(r#"{"integrator": "rk\n4"}"#).lines().count(), 1);
     assert_eq!(
@@ -413,4 +413,21 @@ fn rolling_resistance_and_torsional_friction_are_checked_with_their_paths() {
         );
         assert_eq!(error(&two), format!("bodies[1].{key}: must be >= 0"));
     }
+}
+
+#[test]
+fn the_push_out_speed_is_read_and_checked() {
+    for (value, rule) in [("0", "must be > 0"), ("-3", "must be > 0")] {
+        let scene = format!(r#"{{"max_push_speed": {value}}}"#);
+        assert_eq!(error(&scene), format!("max_push_speed: {rule}"));
+    }
+    assert_eq!(
+        error(r#"{"max_push_speed": "fast"}"#),
+        "max_push_speed: expected a number"
+    );
+    let scene = tumble_scene::load_str(r#"{"max_push_speed": 0.5}"#).unwrap();
+    assert_eq!(scene.world.max_push_speed(), 0.5);
+    // The default follows the length unit, as Box2D's does.
+    let scene = tumble_scene::load_str(r#"{"length_unit": 0.01}"#).unwrap();
+    assert!((scene.world.max_push_speed() - 0.03).abs() < 1e-6);
 }

@@ -134,3 +134,92 @@ fn a_pile_created_interpenetrating_settles() {
         }
     }
 }
+
+/// How far apart (m) the centres of two cubes created half inside each other, with no
+/// gravity, are after each of `steps` steps at `dt`, pushed apart at most at `speed`.
+fn separations(speed: Option<Real>, dt: Real, steps: usize) -> (Vec<Real>, World) {
+    let mut w = World::try_new(&WorldDef {
+        gravity: Vec3::ZERO,
+        sleep: false,
+        max_push_speed: speed,
+        ..Default::default()
+    })
+    .unwrap();
+    let ids: Vec<BodyId> = [-0.25, 0.25]
+        .iter()
+        .map(|&y| {
+            let def = BodyDef {
+                position: Vec3::new(0.0, y, 0.0),
+                ..Default::default()
+            };
+            w.create_body(&def, Shape::cuboid(Vec3::splat(0.5)))
+                .unwrap()
+        })
+        .collect();
+    let gap = |w: &World| {
+        let p = |i: usize| w.body(ids[i]).unwrap().position();
+        (p(1) - p(0)).length()
+    };
+    let mut out = vec![gap(&w)];
+    for _ in 0..steps {
+        w.step(dt).unwrap();
+        out.push(gap(&w));
+    }
+    (out, w)
+}
+
+#[test]
+fn the_push_out_speed_is_a_setting_and_bounds_the_recovery() {
+    // Two 1 m cubes half inside each other: whatever the cap, they part no faster than
+    // it (relative travel per step at most cap × dt, plus float noise), come within the
+    // slop (5 mm, which the soft contact closes) of touching in about 0.5 m / cap, and
+    // are not launched: what they keep is what the
+    // soft contact's correction of the last few millimetres leaves, 0.008 to 0.011 m/s
+    // each (measured), whatever the cap; a launch would keep the cap's speed.
+    assert_eq!(World::new(&WorldDef::default()).max_push_speed(), 3.0);
+    for cap in [0.25 as Real, 1.0, 3.0, 10.0] {
+        for dt in [1.0 / 60.0, 1.0 / 240.0] {
+            let at = format!("cap {cap} m/s, dt {dt:.4}");
+            let need = (0.5 / (cap * dt)).ceil() as usize;
+            let (gaps, w) = separations(Some(cap), dt, 2 * need + 60);
+            for (i, pair) in gaps.windows(2).enumerate() {
+                let opened = pair[1] - pair[0];
+                assert!(
+                    opened <= cap * dt * 1.001 + 1e-9,
+                    "{at}: step {i} opened {opened}"
+                );
+            }
+            let first = gaps.iter().position(|&g| g >= 0.994).unwrap_or(usize::MAX);
+            assert!(
+                first <= need + need / 5 + 10,
+                "{at}: touching only at step {first} of {need}"
+            );
+            for (_, b) in w.bodies() {
+                let v = b.linear_velocity().length();
+                assert!(v < 0.02, "{at}: left moving at {v} m/s");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_bad_push_out_speed_is_refused_and_changes_nothing() {
+    for bad in [0.0, -1.0, Real::NAN, Real::INFINITY] {
+        let def = WorldDef {
+            max_push_speed: Some(bad),
+            ..Default::default()
+        };
+        let e = World::try_new(&def)
+            .err()
+            .expect("a bad max_push_speed is refused");
+        assert!(e.to_string().starts_with("max_push_speed: must be"), "{e}");
+        let mut w = World::new(&WorldDef::default());
+        assert!(w.set_max_push_speed(bad).is_err());
+        assert_eq!(w.max_push_speed(), 3.0);
+    }
+    let unit = WorldDef {
+        length_unit: 0.01,
+        ..Default::default()
+    };
+    assert_eq!(World::new(&unit).max_push_speed(), 3.0 * 0.01);
+}

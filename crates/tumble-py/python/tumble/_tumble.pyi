@@ -338,6 +338,7 @@ class World:
         max_angular_speed: Optional[float] = None,
         max_contacts: Optional[int] = None,
         max_contacts_per_body: Optional[int] = None,
+        max_push_speed: Optional[float] = None,
     ) -> None: ...
     @staticmethod
     def from_scene(path: Union[str, PathLike[str]]) -> World:
@@ -579,6 +580,11 @@ class World:
         """Other bodies a body may be sunk into before it counts as crowded (default 16)."""
     @max_contacts_per_body.setter
     def max_contacts_per_body(self, value: int) -> None: ...
+    @property
+    def max_push_speed(self) -> float:
+        """The fastest contacts push overlapping bodies apart (m/s; default 3·length_unit); assignable."""
+    @max_push_speed.setter
+    def max_push_speed(self, value: float) -> None: ...
     @property
     def contact_margin(self) -> float: ...
     def diagnostics(self) -> Diagnostics:

@@ -75,6 +75,10 @@ pub struct WorldDef {
     pub limits: Option<SpeedLimits>,
     /// How many contacts a body and a step may have (see `limits.rs`).
     pub contact_limits: ContactLimits,
+    /// The fastest that contacts push overlapping bodies apart (m/s), by the solver's
+    /// depth correction and by overlap recovery; `None` takes Box2D's 3 m/s ×
+    /// `length_unit`.
+    pub max_push_speed: Option<Real>,
 }
 
 impl Default for WorldDef {
@@ -87,6 +91,7 @@ impl Default for WorldDef {
             sleep: true,
             limits: None,
             contact_limits: ContactLimits::default(),
+            max_push_speed: None,
         }
     }
 }
@@ -213,6 +218,9 @@ impl World {
             world.set_speed_limits(limits)?;
         }
         world.set_contact_limits(def.contact_limits)?;
+        if let Some(speed) = def.max_push_speed {
+            world.set_max_push_speed(speed)?;
+        }
         Ok(world)
     }
 
@@ -224,7 +232,13 @@ impl World {
         } else {
             1.0
         };
-        let tolerances = Tolerances::new(unit);
+        let mut tolerances = Tolerances::new(unit);
+        if let Some(speed) = def
+            .max_push_speed
+            .filter(|s| check::positive("", *s).is_ok())
+        {
+            tolerances.scales.max_push = speed;
+        }
         World {
             settings: Settings {
                 gravity: def.gravity,
@@ -296,6 +310,19 @@ impl World {
             return Err(Error::invalid("max_contacts", "must be >= 1"));
         }
         self.settings.contacts = limits;
+        Ok(())
+    }
+
+    /// The fastest that contacts push overlapping bodies apart (m/s).
+    pub fn max_push_speed(&self) -> Real {
+        self.settings.tolerances.scales.max_push
+    }
+
+    /// Changes how fast contacts may push overlapping bodies apart; refused (changing
+    /// nothing) unless it is a positive number. It takes effect from the next step.
+    pub fn set_max_push_speed(&mut self, speed: Real) -> Result<()> {
+        check::positive("max_push_speed", speed)?;
+        self.settings.tolerances.scales.max_push = speed;
         Ok(())
     }
 
