@@ -17,7 +17,7 @@ use super::contact_wide::ContactLanes;
 use super::restitution::impact_velocity;
 use super::rows::{self, Frame, Masks, Motion, Pair, Pass, Sums};
 pub(super) use super::rows::{Point, Row};
-use super::softness::Softness;
+use super::softness::{LoadSpring, Softness};
 use crate::collision::contact::Contact;
 use crate::collision::geometry::Pose;
 use crate::collision::narrow_phase::{ContactPoint, Manifold};
@@ -42,6 +42,9 @@ pub(crate) struct BiasRule {
     pub max_push: Real,
     /// Tangential speed above which a contact counts as sliding (m/s).
     pub slip_speed: Real,
+    /// Whether the manifolds' own spring (`Frame::impulse_scale`, stiffened for their load
+    /// in islands with a large mass ratio) is used rather than `softness`'s.
+    pub stiffened: bool,
 }
 
 impl Row {
@@ -186,6 +189,9 @@ pub(crate) struct PairData {
     /// not move), for the speed a falling point reaches at the surface; `None` when both
     /// move under gravity, as one may be resting on something else and not fall at all.
     pub gravity: Option<(Vec3, Vec3)>,
+    /// The contacts' spring: stiffened for its load in an island with a large mass ratio
+    /// (`Some`), as set otherwise.
+    pub spring: (LoadSpring, bool),
 }
 
 impl PairData {
@@ -319,7 +325,7 @@ impl ContactConstraint {
         let tangents = orthonormal_basis(normal);
         let dirs = [normal, tangents[0], tangents[1]];
         let push = |s: &BodySim, k: usize| s.linear_mask * dirs[k] * s.inv_mass;
-        let c = ContactConstraint {
+        let mut c = ContactConstraint {
             a,
             b,
             contact: index,
@@ -330,6 +336,7 @@ impl ContactConstraint {
                 push_b: [push(sb, 0), push(sb, 1), push(sb, 2)],
                 friction,
                 round: round_arms(m, pair.round),
+                impulse_scale: pair.spring.0.base,
             },
             moves: (sa.moves, sb.moves),
             restitution,
@@ -345,6 +352,12 @@ impl ContactConstraint {
             c.add_points::<true>(contact, pair, sims, states, points);
         } else {
             c.add_points::<false>(contact, pair, sims, states, points);
+        }
+        if pair.spring.1 {
+            let added = &points.hot[c.first..];
+            let load = added.iter().map(|p| p.normal_impulse).sum();
+            let mass = added.iter().map(|p| p.normal.mass).sum();
+            c.frame.impulse_scale = pair.spring.0.impulse_scale(load, mass);
         }
         c
     }

@@ -157,6 +157,7 @@ impl ContactLanes {
                     Lanes::from_fn(|l| lane(l).round()[0]),
                     Lanes::from_fn(|l| lane(l).round()[1]),
                 ],
+                impulse_scale: Lanes::from_fn(|l| lane(l).frame.impulse_scale),
             },
             round: cs.iter().any(|c| c.has_round()),
             slot0,

@@ -33,6 +33,7 @@ mod wide;
 use settings::{bias_rule, joint_passes};
 pub(crate) use settings::{Scales, StepTime};
 pub use settings::{SolverKind, SolverSettings};
+use softness::LoadSpring;
 pub use softness::Softness;
 
 pub(crate) use body::{BodySim, BodyState, SolverBodies};
@@ -121,6 +122,7 @@ impl Solver {
                 input.scales.linear_slop,
                 gravity,
                 overlap::Allowance::new(input.settings, time, input.scales.linear_slop),
+                LoadSpring::new(&rule.softness, time.h, gravity.length().max(1.0)),
             ),
         );
         self.prepare_joints(bodies, world_bodies, input.joints, input.joint_bodies);
@@ -223,15 +225,25 @@ impl Solver {
         totals: bool,
     ) {
         let (rule, joint_pass) = rules;
+        let stiffened = BiasRule {
+            stiffened: true,
+            ..*rule
+        };
         let parts = [
-            (0..self.heavy_contacts, 0..self.heavy_joints, iterations),
+            (
+                0..self.heavy_contacts,
+                0..self.heavy_joints,
+                iterations,
+                rule,
+            ),
             (
                 self.heavy_contacts..self.constraints.len(),
                 self.heavy_joints..self.joints.len(),
                 self.heavy_passes * iterations,
+                &stiffened,
             ),
         ];
-        for (contacts, joints, count) in parts {
+        for (contacts, joints, count, rule) in parts {
             for k in 0..count {
                 for j in &mut self.joints[joints.clone()] {
                     j.solve(&bodies.sims, &mut bodies.states, joint_pass);
@@ -277,7 +289,7 @@ impl Solver {
         (bodies, world_bodies): (&SolverBodies, &[Body]),
         contacts: &[Contact],
         ghosts: &[bool],
-        (slop, gravity, allow): (Real, Vec3, overlap::Allowance),
+        (slop, gravity, allow, spring): (Real, Vec3, overlap::Allowance, LoadSpring),
     ) {
         self.constraints.clear();
         self.points.clear();
@@ -291,7 +303,7 @@ impl Solver {
             }
         };
         self.heavy_contacts = order.partition_point(|&(heavy, _, _)| !heavy);
-        for (_, colour, i) in order {
+        for (heavy, colour, i) in order {
             let c = &contacts[i];
             let (a, b) = (c.index_a as usize, c.index_b as usize);
             let (sa, sb) = (&bodies.sims[a], &bodies.sims[b]);
@@ -317,6 +329,7 @@ impl Solver {
                 slop,
                 gravity: (!(sa.moves && sb.moves) || gravity == Vec3::ZERO)
                     .then(|| (falls(sa), falls(sb))),
+                spring: (spring, heavy),
             };
             let first = self.points.hot.len();
             self.constraints.push(ContactConstraint::prepare(

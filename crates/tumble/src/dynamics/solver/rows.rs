@@ -90,6 +90,10 @@ pub(crate) struct Frame<W: Wide = Real> {
     /// capsule's radius (`contact::round_arms`), 0 for a side that is not round; for the
     /// gaps' round parts ([`Moved::normal`], [`Moved::tangent`]).
     pub round: [W; 2],
+    /// The biased pass's impulse scale of the manifold's normal rows, its mass scale 1
+    /// minus this: the contacts' spring, stiffened for a heavy load (see
+    /// `softness::LoadSpring`).
+    pub impulse_scale: W,
 }
 
 /// Which lanes a point's updates reach (see the module docs).
@@ -406,8 +410,16 @@ fn solve_normal<W: Wide, const BIAS: bool>(
                 let error = (sep + W::splat(rule.slop)).min(zero);
                 (
                     (W::splat(soft.bias_rate) * error).max(W::splat(-rule.max_push)),
-                    W::splat(soft.mass_scale),
-                    W::splat(soft.impulse_scale),
+                    if rule.stiffened {
+                        one - f.impulse_scale
+                    } else {
+                        W::splat(soft.mass_scale)
+                    },
+                    if rule.stiffened {
+                        f.impulse_scale
+                    } else {
+                        W::splat(soft.impulse_scale)
+                    },
                 )
             },
         )

@@ -157,5 +157,6 @@ pub(super) fn bias_rule(settings: &SolverSettings, scales: &Scales, time: &StepT
         },
         max_push: scales.max_push,
         slip_speed: scales.linear_slop,
+        stiffened: false,
     }
 }
