@@ -229,21 +229,25 @@ impl Solver {
             stiffened: true,
             ..*rule
         };
+        let stiff_joints = JointPass {
+            soft: joint_pass.soft.stiffened(softness::STIFFEST),
+            ..*joint_pass
+        };
         let parts = [
             (
                 0..self.heavy_contacts,
                 0..self.heavy_joints,
                 iterations,
-                rule,
+                (rule, joint_pass),
             ),
             (
                 self.heavy_contacts..self.constraints.len(),
                 self.heavy_joints..self.joints.len(),
                 self.heavy_passes * iterations,
-                &stiffened,
+                (&stiffened, &stiff_joints),
             ),
         ];
-        for (contacts, joints, count, rule) in parts {
+        for (contacts, joints, count, (rule, joint_pass)) in parts {
             for k in 0..count {
                 for j in &mut self.joints[joints.clone()] {
                     j.solve(&bodies.sims, &mut bodies.states, joint_pass);

@@ -34,6 +34,20 @@ impl Softness {
         impulse_scale: 0.0,
     };
 
+    /// The same spring `s` times as stiff, damped with the same ratio for `s` times the
+    /// mass (see [`LoadSpring`]): the bias rate is kept and hω(2ζ + hω) multiplied by `s`.
+    pub fn stiffened(&self, s: Real) -> Softness {
+        if self.impulse_scale <= 0.0 || s == 1.0 {
+            return *self;
+        }
+        let a2 = s * self.mass_scale / self.impulse_scale;
+        Softness {
+            bias_rate: self.bias_rate,
+            mass_scale: a2 / (1.0 + a2),
+            impulse_scale: 1.0 / (1.0 + a2),
+        }
+    }
+
     /// Coefficients for a spring of `hertz` and damping ratio `zeta` over substep `h`.
     pub fn new(hertz: Real, zeta: Real, h: Real) -> Softness {
         if hertz <= 0.0 {
