@@ -189,9 +189,6 @@ pub(crate) struct PairData {
     /// not move), for the speed a falling point reaches at the surface; `None` when both
     /// move under gravity, as one may be resting on something else and not fall at all.
     pub gravity: Option<(Vec3, Vec3)>,
-    /// The contacts' spring: stiffened for its load in an island with a large mass ratio
-    /// (`Some`), as set otherwise.
-    pub spring: (LoadSpring, bool),
 }
 
 impl PairData {
@@ -325,7 +322,7 @@ impl ContactConstraint {
         let tangents = orthonormal_basis(normal);
         let dirs = [normal, tangents[0], tangents[1]];
         let push = |s: &BodySim, k: usize| s.linear_mask * dirs[k] * s.inv_mass;
-        let mut c = ContactConstraint {
+        let c = ContactConstraint {
             a,
             b,
             contact: index,
@@ -336,7 +333,8 @@ impl ContactConstraint {
                 push_b: [push(sb, 0), push(sb, 1), push(sb, 2)],
                 friction,
                 round: round_arms(m, pair.round),
-                impulse_scale: pair.spring.0.base,
+                // Read only by stiffened passes, after `stiffen` has set it.
+                impulse_scale: 0.0,
             },
             moves: (sa.moves, sb.moves),
             restitution,
@@ -353,13 +351,16 @@ impl ContactConstraint {
         } else {
             c.add_points::<false>(contact, pair, sims, states, points);
         }
-        if pair.spring.1 {
-            let added = &points.hot[c.first..];
-            let load = added.iter().map(|p| p.normal_impulse).sum();
-            let mass = added.iter().map(|p| p.normal.mass).sum();
-            c.frame.impulse_scale = pair.spring.0.impulse_scale(load, mass);
-        }
         c
+    }
+
+    /// Stiffens the manifold's spring for the load its points carried last step (an
+    /// island with a large mass ratio: see `mass_ratio.rs`).
+    pub fn stiffen(&mut self, spring: &LoadSpring, points: &Points) {
+        let added = &points.hot[self.range()];
+        let load = added.iter().map(|p| p.normal_impulse).sum();
+        let mass = added.iter().map(|p| p.normal.mass).sum();
+        self.frame.impulse_scale = spring.impulse_scale(load, mass);
     }
 
     /// Appends the manifold's points to `points`: anchors, rows, warm starts. `ROLLS`:

@@ -333,7 +333,6 @@ impl Solver {
                 slop,
                 gravity: (!(sa.moves && sb.moves) || gravity == Vec3::ZERO)
                     .then(|| (falls(sa), falls(sb))),
-                spring: (spring, heavy),
             };
             let first = self.points.hot.len();
             self.constraints.push(ContactConstraint::prepare(
@@ -344,6 +343,9 @@ impl Solver {
                 &mut self.points,
             ));
             let k = self.constraints.len() - 1;
+            if heavy {
+                self.constraints[k].stiffen(&spring, &self.points);
+            }
             if c.manifold.overlap == Overlap::Clear {
                 continue;
             }

@@ -86,7 +86,7 @@ pub(crate) struct LoadSpring {
     /// hω(2ζ + hω) of the contacts' spring; zero for a rigid row (PGS).
     stiffness: Real,
     /// The impulse scale of an unstiffened manifold.
-    pub base: Real,
+    base: Real,
     /// 1 / (h g): the mass an impulse per substep holds up (kg per N s).
     per_impulse: Real,
 }
