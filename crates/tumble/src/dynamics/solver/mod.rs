@@ -122,8 +122,7 @@ impl Solver {
                 input.scales.linear_slop,
                 gravity,
                 overlap::Allowance::new(input.settings, time, input.scales.linear_slop),
-                // Without gravity a load of 1 m/s² on a manifold's mass counts as its own.
-                LoadSpring::new(&rule.softness, time.h, gravity.length().max(1.0)),
+                LoadSpring::new(&rule.softness, time.h, gravity.length()),
             ),
         );
         self.prepare_joints(bodies, world_bodies, input.joints, input.joint_bodies);

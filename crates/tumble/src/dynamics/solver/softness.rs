@@ -96,8 +96,11 @@ pub(crate) struct LoadSpring {
 pub(crate) const STIFFEST: Real = 4.0;
 
 impl LoadSpring {
-    /// For contacts of softness `soft` over substep `h`, under gravity `g` (m/s²).
+    /// For contacts of softness `soft` over substep `h`, under gravity `g` (m/s²; below
+    /// 1 m/s², and without gravity, a load of 1 m/s² on a manifold's mass counts as its
+    /// own, so that weightless scenes still have a scale).
     pub fn new(soft: &Softness, h: Real, g: Real) -> LoadSpring {
+        let g = g.max(1.0);
         let stiffness = if soft.impulse_scale > 0.0 {
             soft.mass_scale / soft.impulse_scale
         } else {
