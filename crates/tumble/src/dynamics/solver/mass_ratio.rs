@@ -6,9 +6,9 @@
 //! passes held it, but the soft contact under the light body is a spring of the light
 //! body's effective mass, so the pair sank by the mass ratio times a lone box's depth (7 cm
 //! in each contact at 1:1000) and rocked at 3.5 cm/s with three passes; an 800 kg slab on
-//! four 1 kg cubes (200:1 on each) sank 2.8 cm. Such islands' contacts are therefore stiffened for the
-//! load they carry (`softness::LoadSpring`, at most four times), which takes twice the
-//! passes again to stay still: at 1:1000 the pair now rests 3.5 cm deep and moves at
+//! four 1 kg cubes (200:1 on each) sank 2.8 cm. Such islands' contacts are therefore
+//! stiffened for the load they carry (`softness::LoadSpring`, at most four times), which
+//! takes twice the passes again to stay still: at 1:1000 the pair now rests 3.5 cm deep and moves at
 //! 3 mm/s, the slab sinks 6.9 mm, a 1:100 pair 3.5 mm (14 mm before) and is still. Their
 //! joints' spring is four times as stiff too (`Softness::stiffened`): a chain of 1 kg
 //! links holding 100 kg stretched 2.3 cm per joint at the defaults, now 7.4 mm.
@@ -20,8 +20,8 @@ use crate::dynamics::island::{find, union};
 use crate::math::Real;
 
 /// Mass ratio across a contact or joint, between two bodies the solver moves, from which
-/// their island is solved with stiffened contacts and four times the passes. At 1:10 one pass is still at rest to
-/// 0.4 mm/s; at 1:30 it rings (see the module comment).
+/// their island is solved with stiffened contacts and four times the passes. At 1:10 one
+/// pass is still at rest to 0.4 mm/s; at 1:30 it rings (see the module comment).
 pub(crate) const HEAVY_RATIO: Real = 20.0;
 
 /// Mass ratio from which such islands get six times the passes: a 1:1000 pair (unstiffened)

@@ -21,9 +21,9 @@
 //! (`Solver::prepare` clamps its separation), which its soft contact holds as it holds
 //! any resting point, and the rest is taken out here, after the substeps, as a
 //! displacement: Gauss–Seidel passes over the deep points on the linearised separation
-//! s + n·(d_b − d_a) of the bodies' displacements d, each point's total push clamped to
-//! [0, max_push · dt] of relative travel, so a point is pushed apart at most at
-//! `max_push` and the bodies keep the velocities the solver gave them. This is the
+//! s + n·(d_b − d_a) of the bodies' displacements d, each pair's total push clamped to
+//! [0, max_push · dt] of relative travel, the substeps' included, so a pair is pushed
+//! apart at most at `max_push` and the bodies keep the velocities the solver gave them. This is the
 //! position pass of Box2D v2.4 (and Bullet's split impulse) for the points that need it;
 //! a scene with no such pair never enters it. The other points of the pushed bodies are
 //! guards: the pass may not push a body further into a neighbour. The pushes move, never
@@ -155,8 +155,9 @@ pub(crate) struct Scratch {
     left: Vec<Real>,
 }
 
-/// Pushes the deep points' bodies apart to their depth, by at most `reach` (m) of
-/// relative travel per point, moving the poses in `sims` (and `states`' Δp, ΔR) only.
+/// Pushes the deep points' bodies apart to their depth, each pair by at most `reach` (m)
+/// of relative travel in the step, substeps included (see [`push_point`]), moving the
+/// poses in `sims` (and `states`' Δp, ΔR) only.
 pub(crate) fn push_apart(
     constraints: &[ContactConstraint],
     points: &Points,
@@ -239,8 +240,8 @@ fn stop_approach(
 
 /// Adds to `deep` the other points of the bodies it pushes, as guards: their depth now
 /// (or touching, for points still apart) is their target, so the pass may not push a
-/// body further into a neighbour. Without them, of five 1 m cubes created half inside each other, the
-/// bottom one, pushed up, went into the third (which it had just touched), whose
+/// body further into a neighbour. Without them, of five 1 m cubes created half inside
+/// each other, the bottom one, pushed up, went into the third (which it had just touched), whose
 /// contact the solver then resolved in velocity: the column's top left at 1.1 m/s.
 fn add_guards(
     constraints: &[ContactConstraint],
@@ -332,8 +333,8 @@ fn levels(constraints: &[ContactConstraint], sims: &[BodySim], s: &mut Scratch) 
 ///
 /// `left[c]` is what manifold c may still travel apart: the step's reach less the most
 /// any of its points parted in the substeps (the mean let a turning pair part faster
-/// than the cap, and leaned columns twice as far). It bounds the pair's relative travel, not each
-/// point's push: the pushes of a manifold's points all move its bodies along its one
+/// than the cap, and leaned columns twice as far). It bounds the pair's relative travel,
+/// not each point's push: the pushes of a manifold's points all move its bodies along its one
 /// normal, so they add up (capping each point alone let two cubes created half inside
 /// each other part at 4.3 times the cap, their four points each pushing the full reach),
 /// and the solver's own parting (its soft contact holds the point at `depth`, correcting
