@@ -5,19 +5,12 @@
 // Casts between Real and f64 are no-ops in the default build but needed in the f32 one.
 #![allow(clippy::unnecessary_cast)]
 
+mod common;
+use common::awake_on_ground;
 use tumble::prelude::*;
 
 fn world() -> World {
-    let mut w = World::new(&WorldDef {
-        sleep: false,
-        ..Default::default()
-    });
-    let ground = BodyDef {
-        kind: BodyKind::Static,
-        ..Default::default()
-    };
-    w.create_body(&ground, Shape::plane(Vec3::Y, 0.0)).unwrap();
-    w
+    awake_on_ground(WorldDef::default().gravity)
 }
 
 fn body(w: &mut World, at: Vec3, mass: Real, shape: Shape) -> BodyId {

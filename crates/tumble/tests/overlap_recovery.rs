@@ -8,20 +8,12 @@
 // Casts between Real and f64 are no-ops in the default build but needed in the f32 one.
 #![allow(clippy::unnecessary_cast)]
 
+mod common;
+use common::awake_on_ground;
 use tumble::prelude::*;
 
 fn world() -> World {
-    let mut w = World::new(&WorldDef {
-        gravity: Vec3::new(0.0, -9.81, 0.0),
-        sleep: false,
-        ..Default::default()
-    });
-    let ground = BodyDef {
-        kind: BodyKind::Static,
-        ..Default::default()
-    };
-    w.create_body(&ground, Shape::plane(Vec3::Y, 0.0)).unwrap();
-    w
+    awake_on_ground(Vec3::new(0.0, -9.81, 0.0))
 }
 
 /// The fastest any of `ids` moved over `seconds` at `dt`, and the highest centre seen;

@@ -26,6 +26,22 @@ pub fn world(gravity: Vec3, integrator: Integrator) -> World {
     })
 }
 
+/// A world with the given gravity, sleeping off, on a static ground plane y = 0 (default
+/// material).
+pub fn awake_on_ground(gravity: Vec3) -> World {
+    let mut w = World::new(&WorldDef {
+        gravity,
+        sleep: false,
+        ..Default::default()
+    });
+    let ground = BodyDef {
+        kind: BodyKind::Static,
+        ..Default::default()
+    };
+    w.create_body(&ground, Shape::plane(Vec3::Y, 0.0)).unwrap();
+    w
+}
+
 /// A 1 kg ball of radius 0.1 m at `position`.
 pub fn ball(world: &mut World, position: Vec3) -> BodyId {
     world
