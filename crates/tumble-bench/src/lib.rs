@@ -335,6 +335,13 @@ pub mod tumble_engine {
                 ..Default::default()
             },
             sleep: false,
+            // One thread, as the tables say, unless TUMBLE_THREADS asks for more.
+            threads: Some(
+                tumble::threads::threads_from_env()
+                    .ok()
+                    .flatten()
+                    .unwrap_or(1),
+            ),
             ..Default::default()
         })
         .expect("valid world settings");

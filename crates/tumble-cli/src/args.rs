@@ -31,6 +31,13 @@ pub fn whole(text: &str, min: u64, max: u64) -> Result<u64, String> {
         .ok_or_else(|| format!("{}, got '{}'", whole_rule(min, max), printable(text)))
 }
 
+/// `--threads N`: how many threads the steps run on, 1 to `tumble::threads::MAX_THREADS`.
+pub fn threads(text: &str) -> Result<usize, String> {
+    let most = tumble::threads::MAX_THREADS as u64;
+    // In range by construction, so the conversion cannot fail.
+    whole(text, 1, most).map(|n| n as usize)
+}
+
 /// [`whole`] for options held in a `u32`.
 pub fn whole_u32(text: &str, min: u32, max: u32) -> Result<u32, String> {
     // In range by construction, so the conversion cannot fail.

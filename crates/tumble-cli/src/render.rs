@@ -75,6 +75,11 @@ pub struct RenderArgs {
     pub joints: bool,
 
     /// Print nothing on standard output and show no progress bar.
+    /// Threads the steps run on (default: TUMBLE_THREADS, else every core); results are
+    /// bit-identical for every count.
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = crate::args::threads)]
+    pub threads: Option<usize>,
+
     #[arg(long, short)]
     pub quiet: bool,
 }
@@ -188,6 +193,12 @@ impl Sink {
 /// written, and the step's account is the error (exit 1).
 pub fn render(args: &RenderArgs) -> Result<(), Failure> {
     let mut scene = tumble_scene::load(&args.scene)?;
+    if let Some(n) = args.threads {
+        scene
+            .world
+            .set_threads(n)
+            .map_err(|e| Failure::Input(e.to_string()))?;
+    }
     let c = check(args, &scene)?;
     let sink = Sink::create(c.target.clone(), &c.output)?;
     let (snapshots, stopped) = simulate(&mut scene.world, args, &c)?;

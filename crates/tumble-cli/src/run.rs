@@ -90,6 +90,11 @@ pub struct RunArgs {
     #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = passes)]
     pub iterations: Option<u32>,
 
+    /// Threads the steps run on (default: TUMBLE_THREADS, else every core); results are
+    /// bit-identical for every count.
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = crate::args::threads)]
+    pub threads: Option<usize>,
+
     /// Record every K-th step in the CSV files; step 0 and the last step are always
     /// recorded (and, when a step fails, the last good one).
     #[arg(
@@ -122,6 +127,7 @@ impl Default for RunArgs {
             solver: None,
             substeps: None,
             iterations: None,
+            threads: None,
             every: 1,
             quiet: false,
         }
@@ -142,6 +148,12 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
         scene.world.set_integrator(integrator);
     }
     apply_solver_options(args, &mut scene.world)?;
+    if let Some(n) = args.threads {
+        scene
+            .world
+            .set_threads(n)
+            .map_err(|e| Failure::Input(e.to_string()))?;
+    }
     let plan = plan(args, &scene)?;
     let mut sinks = Sinks::open(args, &scene, &plan)?;
     let mut progress = crate::progress::Progress::new(plan.steps, "running", args.quiet);

@@ -47,6 +47,11 @@ pub struct PageArgs {
     )]
     pub fps: Real,
 
+    /// Threads the steps run on (default: TUMBLE_THREADS, else every core); results are
+    /// bit-identical for every count.
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = crate::args::threads)]
+    pub threads: Option<usize>,
+
     /// Show no progress bar and print nothing on standard output but the address
     /// (`view`).
     #[arg(long, short)]
@@ -193,6 +198,12 @@ fn open_browser(url: &str) {
 /// The failure of a step, if one ended the run early, comes second.
 pub fn page(args: &PageArgs) -> Result<(String, Option<Failure>), Failure> {
     let mut scene = tumble_scene::load(&args.scene)?;
+    if let Some(n) = args.threads {
+        scene
+            .world
+            .set_threads(n)
+            .map_err(|e| Failure::Input(e.to_string()))?;
+    }
     if !(args.fps > 0.0 && args.fps <= 1000.0) {
         return Err(SceneError::new("fps", "must be > 0 and <= 1000").into());
     }

@@ -125,3 +125,26 @@ fn numbers_are_printed_short() {
         }
     }
 }
+
+#[test]
+fn threads_are_a_count_from_one_and_do_not_change_a_run() {
+    let rule = "must be a whole number from 1 to 256";
+    for command in ["run", "render", "export-html"] {
+        for bad in ["0", "-2", "1.5", "300"] {
+            let line = refused(&[command, "--threads", bad]);
+            assert_eq!(line, format!("threads: {rule}, got '{bad}'"), "{command}");
+        }
+    }
+    let dir = scratch("threads");
+    let mut files = Vec::new();
+    for threads in ["1", "2", "3"] {
+        let file = dir.join(format!("{threads}.csv"));
+        let args = ["run", "--quiet", "--steps", "60", "--threads", threads, "--out"];
+        ok(&[&args[..], &[path(&file)]].concat());
+        files.push(std::fs::read_to_string(&file).unwrap());
+    }
+    assert!(files[0].lines().count() > 60);
+    assert_eq!(files[1], files[0]);
+    assert_eq!(files[2], files[0]);
+    std::fs::remove_dir_all(dir).unwrap();
+}

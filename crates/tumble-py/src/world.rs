@@ -34,7 +34,7 @@ pub struct Inner {
 /// substeps=4, iterations=1, contact_hertz=60.0, contact_damping_ratio=10.0,
 /// joint_hertz=1000.0, joint_damping_ratio=0.5, baumgarte=0.2, length_unit=1.0,
 /// sleep=True, max_speed=None, max_angular_speed=None, max_contacts=None,
-/// max_contacts_per_body=None, max_push_speed=None). SI units throughout; quaternions
+/// max_contacts_per_body=None, max_push_speed=None, threads=None). SI units throughout; quaternions
 /// are [x, y, z, w].
 /// `max_speed` (m/s) and `max_angular_speed` (rad/s) bound every body's speed (defaults
 /// 1e4·length_unit and 1e5): a step that exceeds them, or whose result is not finite, is
@@ -42,7 +42,8 @@ pub struct Inner {
 /// manifolds (default 1,048,576). `max_contacts_per_body` (default 16) is how many other
 /// bodies a body may be sunk into before two such crowded bodies are no longer paired.
 /// `max_push_speed` (m/s, default 3·length_unit) is the fastest contacts push
-/// overlapping bodies apart.
+/// overlapping bodies apart. `threads` is how many threads a step runs on (default
+/// TUMBLE_THREADS, else every core); results are bit-identical for every count.
 #[pyclass(module = "tumble", name = "World", frozen)]
 pub struct PyWorld {
     // A Mutex rather than PyO3's borrow flag: the engine's World is Send but not Sync
@@ -308,6 +309,13 @@ fn spring_end(
     }
 }
 
+/// A thread count from Python: negative counts get the engine's message for them.
+fn thread_count(n: i64) -> PyResult<usize> {
+    let most = tumble::threads::MAX_THREADS;
+    usize::try_from(n)
+        .map_err(|_| invalid("threads", format!("must be between 1 and {most}, got {n}")))
+}
+
 #[pymethods]
 impl PyWorld {
     #[new]
@@ -316,7 +324,7 @@ impl PyWorld {
         contact_damping_ratio = 10.0, joint_hertz = 1000.0, joint_damping_ratio = 0.5,
         baumgarte = 0.2, length_unit = 1.0, sleep = true, max_speed = None,
         max_angular_speed = None, max_contacts = None, max_contacts_per_body = None,
-        max_push_speed = None))]
+        max_push_speed = None, threads = None))]
     #[allow(clippy::too_many_arguments)]
     fn py_new(
         gravity: Option<&Bound<'_, PyAny>>,
@@ -336,6 +344,7 @@ impl PyWorld {
         max_contacts: Option<i64>,
         max_contacts_per_body: Option<i64>,
         max_push_speed: Option<f64>,
+        threads: Option<i64>,
     ) -> PyResult<Self> {
         let settings = PySolverSettings {
             kind: solver,
@@ -356,6 +365,7 @@ impl PyWorld {
             limits: speed_limits(max_speed, max_angular_speed, length_unit),
             contact_limits: contact_limits(max_contacts, max_contacts_per_body)?,
             max_push_speed: max_push_speed.map(real),
+            threads: threads.map(thread_count).transpose()?,
         };
         let world = World::try_new(&def).map_err(engine)?;
         Ok(PyWorld::new_inner(Inner {
@@ -789,6 +799,19 @@ impl PyWorld {
     fn set_max_push_speed(&self, value: f64) -> PyResult<()> {
         let mut g = self.lock()?;
         g.world.set_max_push_speed(real(value)).map_err(engine)
+    }
+
+    /// How many threads a step runs on (1 to 256; default TUMBLE_THREADS, else every
+    /// core). Assignable; results are bit-identical for every count.
+    #[getter]
+    fn threads(&self) -> PyResult<usize> {
+        Ok(self.lock()?.world.threads())
+    }
+
+    #[setter]
+    fn set_threads(&self, value: i64) -> PyResult<()> {
+        let n = thread_count(value)?;
+        self.lock()?.world.set_threads(n).map_err(engine)
     }
 
     /// Speculative contact distance (m): gaps narrower than this count as contacts.

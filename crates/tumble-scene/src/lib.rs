@@ -184,6 +184,8 @@ fn build(root: &Node<'_>) -> Result<Scene> {
         limits: speed_limits(&obj, length_unit)?,
         contact_limits: contact_limits(&obj)?,
         max_push_speed: obj.real("max_push_speed")?,
+        // A property of the machine, not of the scene: the program running it chooses.
+        threads: None,
     };
     let dt = obj.real("dt")?.unwrap_or(DEFAULT_DT);
     let duration = obj.real("duration")?.unwrap_or(DEFAULT_DURATION);

@@ -339,6 +339,7 @@ class World:
         max_contacts: Optional[int] = None,
         max_contacts_per_body: Optional[int] = None,
         max_push_speed: Optional[float] = None,
+        threads: Optional[int] = None,
     ) -> None: ...
     @staticmethod
     def from_scene(path: Union[str, PathLike[str]]) -> World:
@@ -585,6 +586,10 @@ class World:
         """The fastest contacts push overlapping bodies apart (m/s; default 3·length_unit); assignable."""
     @max_push_speed.setter
     def max_push_speed(self, value: float) -> None: ...
+    @property
+    def threads(self) -> int: ...
+    @threads.setter
+    def threads(self, value: int) -> None: ...
     @property
     def contact_margin(self) -> float: ...
     def diagnostics(self) -> Diagnostics:

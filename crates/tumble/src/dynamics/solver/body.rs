@@ -68,6 +68,81 @@ pub(crate) struct BodyState {
     pub turned: Vec3,
 }
 
+/// Access to the step's body states by index, for the contact passes: a slice when one
+/// thread has them all, [`SharedStates`] when the manifolds of a graph colour are split
+/// over threads.
+pub(crate) trait StateAccess {
+    fn state(&self, i: usize) -> &BodyState;
+    fn set_velocity(&mut self, i: usize, v: Vec3, w: Vec3);
+}
+
+impl StateAccess for [BodyState] {
+    #[inline(always)]
+    fn state(&self, i: usize) -> &BodyState {
+        &self[i]
+    }
+
+    #[inline(always)]
+    fn set_velocity(&mut self, i: usize, v: Vec3, w: Vec3) {
+        let s = &mut self[i];
+        (s.v, s.w) = (v, w);
+    }
+}
+
+/// The body states seen by several threads at once, each of which touches a set of
+/// bodies of its own. Built only by [`SharedStates::new`], whose caller promises that set
+/// (see there); every access is one element through the pointer, never a slice, so that
+/// no reference ever covers an element another thread writes.
+#[derive(Clone, Copy)]
+pub(crate) struct SharedStates<'a> {
+    ptr: *mut BodyState,
+    len: usize,
+    _borrow: std::marker::PhantomData<&'a mut [BodyState]>,
+}
+
+// SAFETY: a `SharedStates` is a `&mut [BodyState]` (which is `Send`) split between
+// threads; sending or sharing it is sound under `new`'s contract, which rules out two
+// threads touching one element while either writes it.
+unsafe impl Send for SharedStates<'_> {}
+unsafe impl Sync for SharedStates<'_> {}
+
+impl<'a> SharedStates<'a> {
+    /// Shares `states`, borrowed exclusively for `'a`, between threads.
+    ///
+    /// # Safety
+    /// While copies of the result are used on several threads at once, every element a
+    /// copy writes (`set_velocity`) must be read or written through no other copy, and an
+    /// element one copy reads may be written by none. `ContactLanes` checks this of each
+    /// run of groups it splits (each moving body in one lane of one group, no body both
+    /// moving in one lane and read in another) before any run is split.
+    pub unsafe fn new(states: &'a mut [BodyState]) -> SharedStates<'a> {
+        SharedStates {
+            ptr: states.as_mut_ptr(),
+            len: states.len(),
+            _borrow: std::marker::PhantomData,
+        }
+    }
+}
+
+impl StateAccess for SharedStates<'_> {
+    #[inline(always)]
+    fn state(&self, i: usize) -> &BodyState {
+        assert!(i < self.len);
+        // SAFETY: `i` is in bounds of the borrowed slice, and by `new`'s contract no
+        // other thread writes element `i` while this copy may read it.
+        unsafe { &*self.ptr.add(i) }
+    }
+
+    #[inline(always)]
+    fn set_velocity(&mut self, i: usize, v: Vec3, w: Vec3) {
+        assert!(i < self.len);
+        // SAFETY: in bounds, and by `new`'s contract element `i` is touched by this copy
+        // alone while it may write it; the reference lives for these two writes only.
+        let s = unsafe { &mut *self.ptr.add(i) };
+        (s.v, s.w) = (v, w);
+    }
+}
+
 /// The rest of a body's solver data.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct BodySim {

@@ -240,13 +240,13 @@ impl Lanes3 {
         }
     }
 
-    /// Lane `l` is `v[index[l]]`: written as a loop, which the compiler inlines into
+    /// Lane `l` is `field(index[l])`: written as a loop, which the compiler inlines into
     /// the kernels, where a closure per lane was left as a call.
     #[inline(always)]
-    pub fn gather<T>(items: &[T], index: &[usize; LANES], field: impl Fn(&T) -> Vec3) -> Lanes3 {
+    pub fn gather_by(index: &[usize; LANES], field: impl Fn(usize) -> Vec3) -> Lanes3 {
         let mut r = Lanes3::default();
         for (l, &i) in index.iter().enumerate() {
-            let v = field(&items[i]);
+            let v = field(i);
             (r.x.0[l], r.y.0[l], r.z.0[l]) = (v.x, v.y, v.z);
         }
         r

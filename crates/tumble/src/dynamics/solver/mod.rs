@@ -48,6 +48,7 @@ use crate::dynamics::force::Wrench;
 use crate::dynamics::integrate::{exact_spin, rotor_drift, System};
 use crate::dynamics::joint::Joint;
 use crate::math::{Mat3, Real, Vec3};
+use crate::threads::Par;
 use std::ops::Range;
 
 /// What the solver needs of a step.
@@ -63,6 +64,8 @@ pub(crate) struct StepInput<'a, 'b> {
     pub joint_bodies: &'a [[Option<usize>; 2]],
     /// The step's time, length and substep.
     pub time: &'a StepTime,
+    /// How the passes may split their work (see `threads.rs`).
+    pub par: Par,
 }
 
 /// Buffers reused from step to step.
@@ -89,6 +92,8 @@ pub(crate) struct Solver {
     /// (see `overlap`), and scratch.
     deep: Vec<overlap::Deep>,
     overlap: overlap::Scratch,
+    /// How this step's passes may split their work.
+    par: Par,
 }
 
 impl Solver {
@@ -102,8 +107,8 @@ impl Solver {
         bodies: &mut SolverBodies,
         contacts: &mut [Contact],
     ) {
-        let world_bodies = input.system.bodies;
-        let time = input.time;
+        let (world_bodies, time) = (input.system.bodies, input.time);
+        self.par = input.par;
         self.start_states.clone_from(&bodies.states);
         let rule = bias_rule(input.settings, input.scales, time);
         self.find_heavy_islands(
@@ -193,7 +198,12 @@ impl Solver {
         for j in &mut self.joints {
             j.warm_start(&bodies.sims, &mut bodies.states);
         }
-        contact_wide::warm_start(&self.constraints, &self.points, &mut bodies.states);
+        contact_wide::warm_start(
+            &self.constraints,
+            &self.points,
+            &mut bodies.states,
+            self.par,
+        );
         let iterations = input.settings.iterations;
         let relax = input.settings.kind == SolverKind::SoftStep && iterations > 0;
         self.passes(bodies, iterations, (rule, solve_pass), true, !relax);
@@ -468,7 +478,7 @@ impl Solver {
     ) {
         let pass = contact_wide::Pass { rule, bias, totals };
         let (cs, points, states) = (&self.constraints, &mut self.points, &mut bodies.states);
-        contact_wide::solve_pass(cs, range, points, states, pass);
+        contact_wide::solve_pass(cs, range, points, states, (pass, self.par));
     }
 
     /// v += h F/m, L += h N, over the substep's start (`end` false) or end: bodies in

@@ -41,6 +41,7 @@ use crate::limits::{ContactLimits, SpeedLimits, MAX_ACCELERATION};
 use crate::math::{Real, Vec3};
 use crate::pipeline::contact_cache::ContactCache;
 use crate::pipeline::diagnostics::{self, Diagnostics};
+use crate::threads::Workers;
 use step::StepContext;
 
 /// A body's velocities must be within the world's speed limits.
@@ -79,6 +80,9 @@ pub struct WorldDef {
     /// depth correction and by overlap recovery; `None` takes Box2D's 3 m/s ×
     /// `length_unit`.
     pub max_push_speed: Option<Real>,
+    /// How many threads a step runs on; `None` takes `TUMBLE_THREADS`, else every core
+    /// (see `threads.rs`). Results are bit-identical for every count.
+    pub threads: Option<usize>,
 }
 
 impl Default for WorldDef {
@@ -92,6 +96,7 @@ impl Default for WorldDef {
             limits: None,
             contact_limits: ContactLimits::default(),
             max_push_speed: None,
+            threads: None,
         }
     }
 }
@@ -205,6 +210,8 @@ pub struct World {
     pub(crate) memory: IntegratorMemory,
     /// Scratch of one step (see `step.rs`): not part of the world's state.
     pub(crate) scratch: StepContext,
+    /// The threads steps run on (a setting, not state: results do not depend on it).
+    pub(crate) workers: Workers,
 }
 
 impl World {
@@ -220,6 +227,12 @@ impl World {
         world.set_contact_limits(def.contact_limits)?;
         if let Some(speed) = def.max_push_speed {
             world.set_max_push_speed(speed)?;
+        }
+        match def.threads {
+            Some(n) => world.set_threads(n)?,
+            None => {
+                crate::threads::threads_from_env()?;
+            }
         }
         Ok(world)
     }
@@ -264,7 +277,25 @@ impl World {
             sleep_tag: 0,
             memory: IntegratorMemory::default(),
             scratch: StepContext::default(),
+            workers: Workers::new(def.threads.unwrap_or_else(crate::threads::default_threads)),
         }
+    }
+
+    /// How many threads a step runs on.
+    pub fn threads(&self) -> usize {
+        self.workers.threads()
+    }
+
+    /// Changes how many threads steps run on (1 to [`MAX_THREADS`]); refused, changing
+    /// nothing, outside that range. Results are bit-identical for every count.
+    ///
+    /// [`MAX_THREADS`]: crate::threads::MAX_THREADS
+    pub fn set_threads(&mut self, threads: usize) -> Result<()> {
+        crate::threads::check(threads)?;
+        if threads != self.workers.threads() {
+            self.workers = Workers::new(threads);
+        }
+        Ok(())
     }
 
     /// Turns sleeping on or off; turning it off wakes everything.
@@ -421,7 +452,13 @@ impl World {
     /// manifold; points keep last update's impulses where their feature ids match. At most
     /// [`ContactLimits::per_step`] are returned (a step that needs more fails).
     pub fn update_contacts(&mut self) -> &[Contact] {
-        self.update_contacts_for(0.0)
+        let mut workers = std::mem::take(&mut self.workers);
+        workers.run(|par| {
+            self.scratch.par = par;
+            self.update_contacts_for(0.0);
+        });
+        self.workers = workers;
+        self.collision.contacts.contacts()
     }
 
     /// The contact update before a step of `dt`: pairs that can close more than the
@@ -435,7 +472,7 @@ impl World {
             self.bodies.ids(),
             (self.settings.tolerances.contact_margin, step),
             &self.joints.joined_pairs,
-            &self.settings.contacts,
+            (&self.settings.contacts, self.scratch.par),
         );
         c.contacts.contacts()
     }

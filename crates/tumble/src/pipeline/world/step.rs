@@ -36,6 +36,7 @@ use crate::error::{check, Result};
 use crate::id::BodyId;
 use crate::math::{Real, Vec3};
 use crate::pipeline::world::World;
+use crate::threads::Par;
 
 /// Everything a step builds and throws away, kept between steps only so that stepping
 /// allocates nothing. Nothing here is read before the step that needs it writes it.
@@ -61,6 +62,8 @@ pub(crate) struct StepContext {
     /// The moved proxies' new tight boxes and displacements, handed to the broad phase
     /// together.
     proxy_updates: Vec<(crate::collision::broad_phase::ProxyId, Aabb, Vec3)>,
+    /// How this step may split its work (see `threads.rs`).
+    pub par: Par,
 }
 
 impl World {
@@ -75,6 +78,16 @@ impl World {
     /// [`Error::Unstable`]: crate::error::Error::Unstable
     pub fn step(&mut self, dt: Real) -> Result<()> {
         check::positive("dt", dt)?;
+        // Out of the world while it runs, so that the step can borrow the whole world.
+        let mut workers = std::mem::take(&mut self.workers);
+        let result = workers.run(|par| self.step_on(dt, par));
+        self.workers = workers;
+        result
+    }
+
+    /// The stages of a step, with `par` telling how they may split their work.
+    fn step_on(&mut self, dt: Real, par: Par) -> Result<()> {
+        self.scratch.par = par;
         let time = StepTime::new(self.clock.time, dt, &self.settings.solver);
         self.refresh_joint_links();
         self.keep_undo();
@@ -197,6 +210,7 @@ impl World {
             joints: &mut self.joints.list,
             joint_bodies: &self.joints.links,
             time,
+            par: ctx.par,
         };
         let contacts = self.collision.contacts.contacts_mut();
         ctx.solver.step(input, &mut ctx.bodies, contacts);
