@@ -139,7 +139,15 @@ fn threads_are_a_count_from_one_and_do_not_change_a_run() {
     let mut files = Vec::new();
     for threads in ["1", "2", "3"] {
         let file = dir.join(format!("{threads}.csv"));
-        let args = ["run", "--quiet", "--steps", "60", "--threads", threads, "--out"];
+        let args = [
+            "run",
+            "--quiet",
+            "--steps",
+            "60",
+            "--threads",
+            threads,
+            "--out",
+        ];
         ok(&[&args[..], &[path(&file)]].concat());
         files.push(std::fs::read_to_string(&file).unwrap());
     }
