@@ -38,6 +38,9 @@ use crate::math::{Real, Vec3};
 use crate::pipeline::world::World;
 use crate::threads::Par;
 
+/// Fewest bodies for which a step goes to the world's threads at all.
+const SMALL_WORLD: usize = 256;
+
 /// Everything a step builds and throws away, kept between steps only so that stepping
 /// allocates nothing. Nothing here is read before the step that needs it writes it.
 #[derive(Default)]
@@ -78,6 +81,12 @@ impl World {
     /// [`Error::Unstable`]: crate::error::Error::Unstable
     pub fn step(&mut self, dt: Real) -> Result<()> {
         check::positive("dt", dt)?;
+        // A small world steps on the calling thread: handing a step to the pool and back
+        // costs tens of µs, more than a few hundred bodies' stages could save (and none
+        // of them splits below that size).
+        if Par::split_at(self.bodies.list.len(), SMALL_WORLD) == 0 {
+            return self.step_on(dt, Par::SERIAL);
+        }
         // Out of the world while it runs, so that the step can borrow the whole world.
         let mut workers = std::mem::take(&mut self.workers);
         let result = workers.run(|par| self.step_on(dt, par));
