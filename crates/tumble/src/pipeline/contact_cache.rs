@@ -830,6 +830,7 @@ fn warm_start(contact: &mut Contact, previous: &Sorted<'_>, poses: (&Pose, &Pose
     };
     contact.manifold.angular_impulse = old.angular_impulse;
     contact.manifold.overlap = old.overlap;
+    contact.manifold.fine = old.fine;
     let mid = |a: Vec3, b: Vec3| (a + b) * 0.5;
     for p in contact.manifold.points_mut() {
         let here = mid(p.point_a, p.point_b);

@@ -88,6 +88,10 @@ pub struct Manifold {
     pub angular_impulse: Vec3,
     /// Whether the pair was found interpenetrating, kept from step to step.
     pub(crate) overlap: Overlap,
+    /// How many times finer than the world's substeps the solver last ran this contact
+    /// (a tall stack's, see `dynamics::solver::stacks`; 0 or 1: the world's own). Its
+    /// warm-start impulses are per such substep, and its depth was sunk at that stiffness.
+    pub(crate) fine: u8,
     points: [ContactPoint; MAX_MANIFOLD_POINTS],
     count: u8,
 }

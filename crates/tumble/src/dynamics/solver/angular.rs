@@ -139,6 +139,11 @@ impl AngularRows {
         s.wb += self.turn_b[k] * lambda;
     }
 
+    /// Scales the warm-start impulses by `k` (a substep `k` times as long).
+    pub fn rescale(&mut self, k: Real) {
+        self.impulse = self.impulse.map(|i| i * k);
+    }
+
     /// Applies the accumulated impulses again (each substep).
     pub fn warm_start(&self, s: &mut Pair) {
         for k in 0..3 {

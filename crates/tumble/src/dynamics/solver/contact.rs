@@ -155,11 +155,12 @@ impl Points {
     }
 
     /// Groups the constraints (in the solver's order) for the wide passes; no group
-    /// spans `split`, where the passes of the heavy islands start.
-    pub fn group_lanes(&mut self, constraints: &[ContactConstraint], split: usize) {
+    /// spans either of `splits`, where the passes of the heavy islands and the tall
+    /// stacks start.
+    pub fn group_lanes(&mut self, constraints: &[ContactConstraint], splits: [usize; 2]) {
         let angular = !self.angular.is_empty();
         self.lanes
-            .build(constraints, (split, angular), &self.hot, &self.cold);
+            .build(constraints, (splits, angular), &self.hot, &self.cold);
     }
 
     /// Brings the grouped points' impulses and totals back from the lanes.
@@ -361,6 +362,19 @@ impl ContactConstraint {
         let load = added.iter().map(|p| p.normal_impulse).sum();
         let mass = added.iter().map(|p| p.normal.mass).sum();
         self.frame.impulse_scale = spring.impulse_scale(load, mass);
+    }
+
+    /// Scales the manifold's warm-start impulses by `k`: last step's were per substep of
+    /// another length (a tall stack's finer substeps, see `stacks.rs`), and an impulse per
+    /// substep goes as the substep's length.
+    pub fn rescale_warm_start(&self, points: &mut Points, k: Real) {
+        for p in &mut points.hot[self.range()] {
+            p.normal_impulse *= k;
+            p.tangent_impulse = p.tangent_impulse.map(|t| t * k);
+        }
+        if let Some(i) = self.angular {
+            points.angular[i as usize].rescale(k);
+        }
     }
 
     /// Appends the manifold's points to `points`: anchors, rows, warm starts. `ROLLS`:

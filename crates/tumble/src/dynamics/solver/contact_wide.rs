@@ -103,13 +103,13 @@ impl ContactLanes {
     }
 
     /// Groups `constraints` (in the solver's order) and copies their points into slots;
-    /// groups stay on one side of `split` (the passes of the heavy islands start there,
-    /// see `Solver::passes`); `angular` says whether any constraint has angular rows,
+    /// groups stay between the `splits` (the passes of the heavy islands and the tall
+    /// stacks start there, see `Solver::passes`); `angular` says whether any constraint has angular rows,
     /// which stay scalar. No groups in scalar mode.
     pub fn build(
         &mut self,
         constraints: &[ContactConstraint],
-        (split, angular): (usize, bool),
+        ([heavy, tall], angular): ([usize; 2], bool),
         hot: &[Point],
         cold: &[PointCold],
     ) {
@@ -117,7 +117,7 @@ impl ContactLanes {
         if lane_mode() == LaneMode::Scalar {
             return;
         }
-        for part in [0..split, split..constraints.len()] {
+        for part in [0..heavy, heavy..tall, tall..constraints.len()] {
             let mut start = part.start;
             while start < part.end {
                 let colour = constraints[start].colour();
@@ -423,10 +423,11 @@ fn rotation<S: StateAccess + ?Sized>(states: &S, index: &[usize; LANES]) -> [Lan
     ]
 }
 
-/// Warm starts every contact: the groups in lanes, the others one by one, all in the
-/// solver's order.
+/// Warm starts the contacts in `range`: the groups in lanes, the others one by one, all
+/// in the solver's order. No group straddles either end of `range`.
 pub(crate) fn warm_start(
     constraints: &[ContactConstraint],
+    range: Range<usize>,
     points: &Points,
     states: &mut [BodyState],
     par: Par,
@@ -435,33 +436,39 @@ pub(crate) fn warm_start(
     if super::lanes::use_avx2() {
         // SAFETY: `use_avx2` has checked that this CPU supports AVX2, the only feature
         // `warm_start_avx2` is compiled for; it has no other requirement.
-        unsafe { warm_start_avx2(constraints, points, states, par) };
+        unsafe { warm_start_avx2(constraints, range, points, states, par) };
         return;
     }
-    warm_start_lanes(constraints, points, states, par);
+    warm_start_lanes(constraints, range, points, states, par);
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn warm_start_avx2(
     constraints: &[ContactConstraint],
+    range: Range<usize>,
     points: &Points,
     states: &mut [BodyState],
     par: Par,
 ) {
-    warm_start_lanes(constraints, points, states, par);
+    warm_start_lanes(constraints, range, points, states, par);
 }
 
 #[inline(always)]
 fn warm_start_lanes(
     constraints: &[ContactConstraint],
+    range: Range<usize>,
     points: &Points,
     states: &mut [BodyState],
     par: Par,
 ) {
     let lanes = &points.lanes;
-    let (mut next, mut gi, mut runs) = (0, 0, lanes.runs.iter().peekable());
-    while gi < lanes.groups.len() {
+    let from = lanes.groups.partition_point(|g| g.first < range.start);
+    let to = lanes.groups.partition_point(|g| g.first < range.end);
+    let first_run = lanes.runs.partition_point(|r| r.start < from);
+    let mut runs = lanes.runs[first_run..].iter().peekable();
+    let (mut next, mut gi) = (range.start, from);
+    while gi < to {
         let g = &lanes.groups[gi];
         for c in &constraints[next..g.first] {
             c.warm_start(points, states);
@@ -486,7 +493,7 @@ fn warm_start_lanes(
         next = g.first + g.lanes;
         gi += 1;
     }
-    for c in &constraints[next..] {
+    for c in &constraints[next..range.end] {
         c.warm_start(points, states);
     }
 }

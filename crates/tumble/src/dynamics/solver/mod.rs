@@ -10,6 +10,7 @@
 //!     solve     (iterations passes, with position bias: soft spring or Baumgarte)
 //!     drift     x += h v, q by the rotor splitting with L (exact torque-free turning)
 //!     relax     (soft step only: passes without bias, removing the push-out velocity)
+//!     tall stacks: k finer substeps of their own (kick, warm start, solve, drift, relax)
 //! bounces (restitution.rs), then store impulses for the next step's warm start
 //! ```
 //!
@@ -28,6 +29,7 @@ mod restitution;
 mod rows;
 mod settings;
 mod softness;
+mod stacks;
 mod wide;
 
 use settings::{bias_rule, joint_passes};
@@ -84,6 +86,12 @@ pub(crate) struct Solver {
     heavy_contacts: usize,
     heavy_joints: usize,
     heavy_passes: u32,
+    /// Per body, whether its island is a tall stack (see `stacks`); empty when none is.
+    /// Such islands' contacts sit last, from `tall_contacts`, and run `fine` substeps
+    /// for each of the world's (`fine` is 1 when there is none).
+    tall: Vec<bool>,
+    tall_contacts: usize,
+    fine: u32,
     /// Bodies whose kick is split around the drift (see `split_kicks`).
     split_kick: Vec<bool>,
     wrench: Vec<Wrench>,
@@ -111,13 +119,8 @@ impl Solver {
         self.par = input.par;
         self.start_states.clone_from(&bodies.states);
         let rule = bias_rule(input.settings, input.scales, time);
-        self.find_heavy_islands(
-            bodies,
-            contacts,
-            input.ghosts,
-            input.joints,
-            input.joint_bodies,
-        );
+        self.find_islands(&input, bodies, contacts);
+        let fine_rule = self.fine_rule(input.settings, input.scales, time);
         let gravity = input.system.gravity;
         self.prepare(
             (bodies, world_bodies),
@@ -133,8 +136,9 @@ impl Solver {
         self.prepare_joints(bodies, world_bodies, input.joints, input.joint_bodies);
         let passes = joint_passes(input.settings, time);
         let any_split = self.split_kicks(bodies);
+        let rules = (&rule, &fine_rule, &passes);
         for i in 0..time.substeps {
-            self.substep(bodies, &mut input, (&rule, &passes), i, any_split);
+            self.substep(bodies, &mut input, rules, i, any_split);
         }
         for j in &self.joints {
             j.store(&mut input.joints[j.joint], time.dt);
@@ -161,14 +165,7 @@ impl Solver {
             input.scales.max_push * time.dt,
             &mut self.overlap,
         );
-        for c in &self.constraints {
-            c.store_impulses(&self.points, &mut contacts[c.contact]);
-            contacts[c.contact].manifold.overlap = Overlap::Clear;
-        }
-        for d in self.deep.iter().filter(|d| !d.guard) {
-            let c = &self.constraints[d.constraint as usize];
-            contacts[c.contact].manifold.overlap = Overlap::Recovering;
-        }
+        self.store_contacts(contacts);
         for ((sim, state), body) in bodies
             .sims
             .iter_mut()
@@ -182,12 +179,35 @@ impl Solver {
         }
     }
 
+    /// Writes back each solved contact's impulses, the rate it was solved at, and whether
+    /// it is still being pushed out of an overlap.
+    fn store_contacts(&self, contacts: &mut [Contact]) {
+        for (k, c) in self.constraints.iter().enumerate() {
+            let m = &mut contacts[c.contact].manifold;
+            m.fine = if k >= self.tall_contacts {
+                self.fine
+            } else {
+                1
+            } as u8;
+            m.overlap = Overlap::Clear;
+            c.store_impulses(&self.points, &mut contacts[c.contact]);
+        }
+        for d in self.deep.iter().filter(|d| !d.guard) {
+            let c = &self.constraints[d.constraint as usize];
+            contacts[c.contact].manifold.overlap = Overlap::Recovering;
+        }
+    }
+
     /// Substep `i`: kick, warm start, solve, drift, relax (see the module header).
     fn substep(
         &mut self,
         bodies: &mut SolverBodies,
         input: &mut StepInput<'_, '_>,
-        (rule, (solve_pass, relax_pass)): (&BiasRule, &(JointPass, JointPass)),
+        (rule, fine_rule, (solve_pass, relax_pass)): (
+            &BiasRule,
+            &BiasRule,
+            &(JointPass, JointPass),
+        ),
         i: u32,
         any_split: bool,
     ) {
@@ -195,11 +215,15 @@ impl Solver {
         let t = input.time.t + i as Real * h;
         // After a split kick's second half the forces are those of this substep's start.
         self.kick(bodies, input.system, t, h, (i == 0 || !any_split, false));
+        if self.fine > 1 {
+            self.fine_substeps(bodies, input, fine_rule);
+        }
         for j in &mut self.joints {
             j.warm_start(&bodies.sims, &mut bodies.states);
         }
         contact_wide::warm_start(
             &self.constraints,
+            0..self.tall_contacts,
             &self.points,
             &mut bodies.states,
             self.par,
@@ -207,7 +231,7 @@ impl Solver {
         let iterations = input.settings.iterations;
         let relax = input.settings.kind == SolverKind::SoftStep && iterations > 0;
         self.passes(bodies, iterations, (rule, solve_pass), true, !relax);
-        self.drift(bodies, world_bodies, h);
+        self.drift(bodies, world_bodies, h, false);
         if any_split {
             self.kick(bodies, input.system, t + h, h, (true, true));
         }
@@ -251,7 +275,7 @@ impl Solver {
                 (rule, joint_pass),
             ),
             (
-                self.heavy_contacts..self.constraints.len(),
+                self.heavy_contacts..self.tall_contacts,
                 self.heavy_joints..self.joints.len(),
                 self.heavy_passes * iterations,
                 (&stiffened, &stiff_joints),
@@ -264,6 +288,129 @@ impl Solver {
                 }
                 let last = totals && k + 1 == count;
                 self.solve_pass(bodies, contacts.clone(), rule, bias, last);
+            }
+        }
+    }
+
+    /// Finds the islands whose contacts get passes of their own: those with a large mass
+    /// ratio (`mass_ratio`) and tall stacks (`stacks`).
+    fn find_islands(
+        &mut self,
+        input: &StepInput<'_, '_>,
+        bodies: &SolverBodies,
+        contacts: &[Contact],
+    ) {
+        let (ghosts, joint_bodies) = (input.ghosts, input.joint_bodies);
+        self.find_heavy_islands(bodies, contacts, ghosts, input.joints, joint_bodies);
+        let (g, slop) = (input.system.gravity.length(), input.scales.linear_slop);
+        self.find_tall_islands(
+            (bodies, input.system.bodies, contacts),
+            (ghosts, joint_bodies),
+            (input.settings, input.time, g, slop),
+        );
+    }
+
+    /// Marks the bodies of tall stacks (see `stacks`) and sets how many times finer their
+    /// substeps are, from the contacts the step will solve (soft step only: PGS has no
+    /// spring to sag, and without passes nothing is solved).
+    fn find_tall_islands(
+        &mut self,
+        (bodies, world_bodies, contacts): (&SolverBodies, &[Body], &[Contact]),
+        (ghosts, joint_bodies): (&[bool], &[[Option<usize>; 2]]),
+        (settings, time, g, slop): (&SolverSettings, &StepTime, Real, Real),
+    ) {
+        self.tall.clear();
+        self.fine = 1;
+        if settings.kind != SolverKind::SoftStep || settings.iterations == 0 {
+            return;
+        }
+        // Pairs being pushed out of an overlap (`overlap.rs`), or new and deeper than the
+        // slop (they may have been made overlapping), keep their islands at the world's
+        // rate until they are out: the push-out's allowances are the world rate's.
+        let busy = |c: &Contact| match c.manifold.overlap {
+            Overlap::Clear => false,
+            Overlap::Recovering => true,
+            Overlap::New => c.manifold.points().iter().any(|p| p.separation < -slop),
+        };
+        let supports: Vec<stacks::Support> = contacts
+            .iter()
+            .enumerate()
+            .filter(|&(i, c)| !idle(c, i, ghosts))
+            .map(|(_, c)| stacks::Support {
+                a: c.index_a as usize,
+                b: c.index_b as usize,
+                busy: busy(c),
+                was_fine: c.manifold.fine > 1,
+            })
+            .collect();
+        let fixed = |k: usize| match world_bodies[k].kind {
+            BodyKind::Kinematic => stacks::Fixed::Kinematic,
+            _ => stacks::Fixed::Ground,
+        };
+        let joined = joint_bodies.iter().flatten().flatten().copied();
+        let scale = stacks::Scale {
+            g,
+            omega: 2.0 * crate::math::PI * settings.contact_hertz.min(0.25 * time.inv_h),
+            tolerance: slop,
+            rest_speed: (2.0 * g * time.dt).max((2.0 * g * slop).sqrt()),
+        };
+        let speed = |k: usize| bodies.states[k].v.length();
+        let sims = (&bodies.sims[..], speed);
+        if let Some((tall, fine)) =
+            stacks::tall_islands(sims, fixed, &supports, (joined, &self.heavy), scale)
+        {
+            (self.tall, self.fine) = (tall, fine);
+        }
+    }
+
+    /// The contacts' bias rule at the tall stacks' substep: `fine` times the substeps and
+    /// the contact frequency (the quarter-rate cap moves with them).
+    fn fine_rule(&self, settings: &SolverSettings, scales: &Scales, time: &StepTime) -> BiasRule {
+        let fine = SolverSettings {
+            substeps: time.substeps * self.fine,
+            contact_hertz: settings.contact_hertz * self.fine as Real,
+            ..*settings
+        };
+        bias_rule(&fine, scales, &StepTime::new(time.t, time.dt, &fine))
+    }
+
+    /// The tall stacks' `fine` substeps within one of the world's, on their own bodies and
+    /// contacts (disjoint from the others'): each a kick with the forces of the world's
+    /// substep, a warm start, the solve, the drift and the relax, at the stiffer `rule`.
+    fn fine_substeps(
+        &mut self,
+        bodies: &mut SolverBodies,
+        input: &mut StepInput<'_, '_>,
+        rule: &BiasRule,
+    ) {
+        let h = input.time.h / self.fine as Real;
+        let range = self.tall_contacts..self.constraints.len();
+        let iterations = input.settings.iterations;
+        for _ in 0..self.fine {
+            self.kick_tall(bodies, input.system.bodies, h);
+            let (cs, points) = (&self.constraints, &self.points);
+            contact_wide::warm_start(cs, range.clone(), points, &mut bodies.states, self.par);
+            for _ in 0..iterations {
+                self.solve_pass(bodies, range.clone(), rule, true, false);
+            }
+            self.drift(bodies, input.system.bodies, h, true);
+            for k in 0..iterations {
+                self.solve_pass(bodies, range.clone(), rule, false, k + 1 == iterations);
+            }
+        }
+    }
+
+    /// The tall stacks' bodies' kick over `h`, with the forces of the world's substep.
+    fn kick_tall(&mut self, bodies: &mut SolverBodies, world_bodies: &[Body], h: Real) {
+        for (k, ((sim, state), body)) in bodies
+            .sims
+            .iter_mut()
+            .zip(&mut bodies.states)
+            .zip(world_bodies)
+            .enumerate()
+        {
+            if is_flagged(&self.tall, k) {
+                kick_body((sim, state), &self.wrench[k], body, h);
             }
         }
     }
@@ -316,8 +463,9 @@ impl Solver {
                 Vec3::ZERO
             }
         };
-        self.heavy_contacts = order.partition_point(|&(heavy, _, _)| !heavy);
-        for (heavy, colour, i) in order {
+        self.heavy_contacts = order.partition_point(|&(part, _, _)| part < Part::Heavy as u8);
+        self.tall_contacts = order.partition_point(|&(part, _, _)| part < Part::Tall as u8);
+        for (part, colour, i) in order {
             let c = &contacts[i];
             let (a, b) = (c.index_a as usize, c.index_b as usize);
             let (sa, sb) = (&bodies.sims[a], &bodies.sims[b]);
@@ -353,9 +501,7 @@ impl Solver {
                 &mut self.points,
             ));
             let k = self.constraints.len() - 1;
-            if heavy {
-                self.constraints[k].stiffen(&spring, &self.points);
-            }
+            self.fit_to_part(k, part, c.manifold.fine, &spring);
             if c.manifold.overlap == Overlap::Clear {
                 continue;
             }
@@ -370,7 +516,26 @@ impl Solver {
             }
         }
         self.points
-            .group_lanes(&self.constraints, self.heavy_contacts);
+            .group_lanes(&self.constraints, [self.heavy_contacts, self.tall_contacts]);
+    }
+
+    /// Fits constraint `k` to its `part`'s passes: warm starts made per substep of the
+    /// length it was last solved at (`was` times finer than the world's) brought to this
+    /// step's, and a heavy island's contacts stiffened for their load.
+    fn fit_to_part(&mut self, k: usize, part: u8, was: u8, spring: &LoadSpring) {
+        let fine = if part == Part::Tall as u8 {
+            self.fine
+        } else {
+            1
+        };
+        let was = u32::from(was.max(1));
+        if was != fine {
+            let share = was as Real / fine as Real;
+            self.constraints[k].rescale_warm_start(&mut self.points, share);
+        }
+        if part == Part::Heavy as u8 {
+            self.constraints[k].stiffen(spring, &self.points);
+        }
     }
 
     /// Chooses each body's kick. Bodies in contact take symplectic Euler's whole kick
@@ -418,8 +583,12 @@ impl Solver {
         // Joints of islands with a large mass ratio go last, in creation order, for their
         // extra passes (see `passes`); the others keep their order.
         let flags = &self.heavy;
-        let heavy =
-            |c: &JointConstraint| c.bodies().into_iter().flatten().any(|k| is_heavy(flags, k));
+        let heavy = |c: &JointConstraint| {
+            c.bodies()
+                .into_iter()
+                .flatten()
+                .any(|k| is_flagged(flags, k))
+        };
         let (mut light, heavy): (Vec<_>, Vec<_>) = self.joints.drain(..).partition(|c| !heavy(c));
         self.heavy_joints = light.len();
         light.extend(heavy);
@@ -437,7 +606,7 @@ impl Solver {
         sims: &[BodySim],
         contacts: &[Contact],
         ghosts: &[bool],
-    ) -> Vec<(bool, u32, usize)> {
+    ) -> Vec<(u8, u32, usize)> {
         let mut used = vec![0u64; sims.len()];
         let mut coloured = Vec::with_capacity(contacts.len());
         for (i, c) in contacts.iter().enumerate() {
@@ -452,8 +621,15 @@ impl Solver {
                     used[k] |= 1u64 << colour;
                 }
             }
-            let heavy = is_heavy(&self.heavy, a) || is_heavy(&self.heavy, b);
-            coloured.push((heavy, colour, i));
+            let on = |flags: &[bool]| is_flagged(flags, a) || is_flagged(flags, b);
+            let part = if on(&self.tall) {
+                Part::Tall
+            } else if on(&self.heavy) {
+                Part::Heavy
+            } else {
+                Part::Light
+            };
+            coloured.push((part as u8, colour, i));
         }
         // Within a colour below 63 the order is free (no moving body in common, so the
         // updates commute, bit for bit): manifolds of equal size go together, so that the
@@ -462,7 +638,7 @@ impl Solver {
             63 => 0,
             _ => contacts[i].manifold.len(),
         };
-        coloured.sort_unstable_by_key(|&(heavy, colour, i)| (heavy, colour, size(colour, i), i));
+        coloured.sort_unstable_by_key(|&(part, colour, i)| (part, colour, size(colour, i), i));
         coloured
     }
 
@@ -494,25 +670,22 @@ impl Solver {
         if evaluate {
             self.evaluate_forces(bodies, system, t);
         }
-        for ((((sim, state), w), body), &split) in bodies
+        for (k, ((((sim, state), w), body), &split)) in bodies
             .sims
             .iter_mut()
             .zip(&mut bodies.states)
             .zip(&self.wrench)
             .zip(system.bodies)
             .zip(&self.split_kick)
+            .enumerate()
         {
             let h = match (split, end) {
                 (true, _) => 0.5 * h,
                 (false, false) => h,
                 (false, true) => continue,
             };
-            if sim.moves {
-                sim.sync_momentum(state);
-                state.v += sim.linear_mask * w.force * (sim.inv_mass * h);
-                sim.l += w.torque * h;
-                state.w = body.omega_from_momentum(sim.q, sim.l);
-                sim.w_synced = state.w;
+            if sim.moves && !is_flagged(&self.tall, k) {
+                kick_body((sim, state), w, body, h);
             }
         }
     }
@@ -526,11 +699,20 @@ impl Solver {
         system.wrenches(t, &self.motions, &mut self.wrench);
     }
 
-    /// x += h v and the exact torque-free rotation with L; kinematic bodies move too, so
-    /// contacts see them where they are.
-    fn drift(&mut self, solver_bodies: &mut SolverBodies, bodies: &[Body], h: Real) {
+    /// x += h v and the exact torque-free rotation with L, for the tall stacks' bodies
+    /// (`tall`) or the others; kinematic bodies move with the others, so contacts see them
+    /// where they are.
+    fn drift(&mut self, solver_bodies: &mut SolverBodies, bodies: &[Body], h: Real, tall: bool) {
         let (sims, states) = (&mut solver_bodies.sims, &mut solver_bodies.states);
-        for ((sim, state), body) in sims.iter_mut().zip(states.iter_mut()).zip(bodies) {
+        for (k, ((sim, state), body)) in sims
+            .iter_mut()
+            .zip(states.iter_mut())
+            .zip(bodies)
+            .enumerate()
+        {
+            if is_flagged(&self.tall, k) != tall {
+                continue;
+            }
             match (sim.moves, body.kind) {
                 (true, _) => {
                     // The ω the substep's rows saw: the one the drift turns with.
@@ -554,10 +736,27 @@ impl Solver {
     }
 }
 
-/// Whether body `k` is in an island with a large mass ratio, by the solver's `heavy` flags
-/// (empty when no island has one).
-fn is_heavy(heavy: &[bool], k: usize) -> bool {
-    heavy.get(k).copied().unwrap_or(false)
+/// v += h F/m, L += h N for one body the solver moves.
+fn kick_body((sim, state): (&mut BodySim, &mut BodyState), w: &Wrench, body: &Body, h: Real) {
+    sim.sync_momentum(state);
+    state.v += sim.linear_mask * w.force * (sim.inv_mass * h);
+    sim.l += w.torque * h;
+    state.w = body.omega_from_momentum(sim.q, sim.l);
+    sim.w_synced = state.w;
+}
+
+/// Whether body `k` is flagged in per-body `flags` that are empty when none is (the
+/// solver's `heavy` and `tall` islands).
+fn is_flagged(flags: &[bool], k: usize) -> bool {
+    flags.get(k).copied().unwrap_or(false)
+}
+
+/// Which passes a contact gets: its island's (see `Solver::colour_order`).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Part {
+    Light,
+    Heavy,
+    Tall,
 }
 
 /// Whether contact `i` sits the step out: no points, or a speculative ghost.
