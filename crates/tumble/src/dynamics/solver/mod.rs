@@ -355,7 +355,8 @@ impl Solver {
             rest_speed: (2.0 * g * time.dt).max((2.0 * g * slop).sqrt()),
         };
         let speed = |k: usize| bodies.states[k].v.length();
-        let sims = (&bodies.sims[..], speed);
+        let half_thickness = |k: usize| world_bodies[k].ccd_extent;
+        let sims = (&bodies.sims[..], speed, half_thickness);
         if let Some((tall, fine)) =
             stacks::tall_islands(sims, fixed, &supports, (joined, &self.heavy), scale)
         {
