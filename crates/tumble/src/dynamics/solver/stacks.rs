@@ -19,7 +19,8 @@
 //! supports. Predicted rather than measured, it is known from the step a stack is built,
 //! before it sinks: measuring the depths instead switched a tower over only once it had
 //! sunk, and the switch made it sway 16 cm. An island whose sag would exceed the tolerance
-//! (the linear slop: the depth the engine already treats as touching) is solved with `k`
+//! (the linear slop, the depth the engine already treats as touching, or [`SAG_SHARE`] of
+//! its thinnest body where that is less) is solved with `k`
 //! times the substeps and `k` times the contact frequency, `k` = ⌈√(sag / tolerance)⌉ at
 //! most [`FINEST`], which brings its sag under the tolerance while every substep sees the
 //! same hω as at the world's rate. Measured
