@@ -67,6 +67,42 @@ impl PyJointSpring {
     }
 }
 
+/// A position servo on a hinge or slider: drives the joint towards `target` (rad or m)
+/// as a spring of `stiffness` (N·m/rad or N/m) and a damper of `damping` (N·m·s/rad or
+/// N·s/m) would, with at most `max_force` (N·m or N); solved implicitly, stable at any
+/// stiffness.
+#[pyclass(module = "tumble", name = "Servo", frozen, get_all)]
+pub struct PyServo {
+    /// Target angle (rad) or position (m).
+    target: f64,
+    /// Stiffness (N·m/rad or N/m).
+    stiffness: f64,
+    /// Damping (N·m·s/rad or N·s/m).
+    damping: f64,
+    /// Largest torque (N·m) or force (N).
+    max_force: f64,
+}
+
+#[pymethods]
+impl PyServo {
+    #[new]
+    fn new(target: f64, stiffness: f64, damping: f64, max_force: f64) -> Self {
+        PyServo {
+            target,
+            stiffness,
+            damping,
+            max_force,
+        }
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "tumble.Servo({}, {}, {}, {})",
+            self.target, self.stiffness, self.damping, self.max_force
+        )
+    }
+}
+
 /// A joint in a world: its `name`, `kind`, `body` and `other` (None: the world), whether it
 /// is `broken`, and the `reaction_force` (N) and `reaction_torque` (N·m) it applied to
 /// `other` over the last step (`body` felt the opposite).
@@ -249,6 +285,22 @@ fn option_value(option: JointOption, o: &Bound<'_, PyAny>) -> PyResult<OptionVal
                 target: real(s.target),
             })
         }
+        OptionShape::Servo => {
+            let s = o.cast::<PyServo>().map_err(|_| {
+                wrong_type(
+                    key,
+                    "a tumble.Servo(target, stiffness, damping, max_force)",
+                    o,
+                )
+            })?;
+            let s = s.get();
+            OptionValue::Servo(tumble::Servo {
+                target: real(s.target),
+                stiffness: real(s.stiffness),
+                damping: real(s.damping),
+                max_force: real(s.max_force),
+            })
+        }
     })
 }
 
@@ -380,6 +432,7 @@ impl PyWorld {
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyMotor>()?;
     m.add_class::<PyJointSpring>()?;
+    m.add_class::<PyServo>()?;
     m.add_class::<PyJoint>()?;
     Ok(())
 }
