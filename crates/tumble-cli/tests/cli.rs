@@ -517,6 +517,10 @@ fn joint_reactions_are_written_and_carry_the_load() {
     );
     assert_eq!(last[6], 0.0, "the hinge broke");
     // The motor (1 rad/s) has opened it onto its 90° limit, where it rests.
-    assert!((last[7] - std::f64::consts::FRAC_PI_2).abs() < 0.01, "angle {}", last[7]);
+    assert!(
+        (last[7] - std::f64::consts::FRAC_PI_2).abs() < 0.01,
+        "angle {}",
+        last[7]
+    );
     assert!(last[8].abs() < 0.05, "rate {}", last[8]);
 }

@@ -96,7 +96,8 @@ impl World {
     /// joint, a broken or disabled one, a coordinate of the wrong shape or out of range
     /// (`position: must be > 0` for a distance), when both sides are anchored or joined
     /// by another path (a closed loop), or when a body would leave the world's range or
-    /// its plane. Wakes every body it moves.
+    /// its plane. Wakes every body it moves. A hinge angle is read back in (−π, π]: a
+    /// `q` outside it poses the same angle, turning the short way.
     pub fn set_joint_position(&mut self, id: JointId, q: JointCoordinate) -> Result<()> {
         let k = self.joints.handles.dense(id).ok_or_else(|| unknown(id))?;
         let joint = &self.joints.list[k];
