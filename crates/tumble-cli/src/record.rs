@@ -4,7 +4,7 @@
 
 use std::fmt;
 
-use tumble::{Real, World};
+use tumble::{JointCoordinate, Real, World};
 
 use crate::output::{Target, Writer};
 use crate::Failure;
@@ -15,7 +15,8 @@ pub const TRAJECTORY_HEADER: &str = "time,body,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,
 pub const CONTACT_IMPULSES_HEADER: &str =
     "time,body_a,body_b,x,y,z,nx,ny,nz,normal_impulse,tangent_impulse";
 /// Header of the joints file.
-pub const JOINT_REACTIONS_HEADER: &str = "time,joint,body,other,fx,fy,fz,tx,ty,tz,broken";
+pub const JOINT_REACTIONS_HEADER: &str = "time,joint,body,other,fx,fy,fz,tx,ty,tz,broken,\
+position,velocity,position_x,position_y,position_z,velocity_x,velocity_y,velocity_z";
 /// Header of the diagnostics file.
 pub const DIAGNOSTICS_HEADER: &str = "time,kinetic,potential,total,px,py,pz,lx,ly,lz";
 
@@ -47,6 +48,30 @@ impl fmt::Display for Num {
             write!(f, "{:e}", self.0)
         } else {
             write!(f, "{}", self.0)
+        }
+    }
+}
+
+/// A joint's coordinate and rate as the joints file's last eight fields (see
+/// `CsvFile::joints`).
+struct Coordinates(Option<JointCoordinate>, Option<JointCoordinate>);
+
+impl fmt::Display for Coordinates {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        use JointCoordinate::{Scalar, Vector};
+        match (self.0, self.1) {
+            (Some(Scalar(q)), Some(Scalar(v))) => write!(f, "{},{},,,,,,", Num(q), Num(v)),
+            (Some(Vector(q)), Some(Vector(v))) => write!(
+                f,
+                ",,{},{},{},{},{},{}",
+                Num(q.x),
+                Num(q.y),
+                Num(q.z),
+                Num(v.x),
+                Num(v.y),
+                Num(v.z)
+            ),
+            _ => write!(f, ",,,,,,,"),
         }
     }
 }
@@ -149,17 +174,20 @@ impl CsvFile {
 
     /// A row per joint: its label (name, or index in creation order), its bodies (`world`
     /// for none), and the force and torque it applied to `other` over the last step
-    /// (N, N·m; the force on `body` is the opposite), and whether it has broken.
+    /// (N, N·m; the force on `body` is the opposite), whether it has broken, and its
+    /// coordinate and rate: `position,velocity` for hinges, sliders and distance joints
+    /// (the `_x,_y,_z` columns empty), `position_x..velocity_z` for ball and fixed joints
+    /// (rotation vector and relative angular velocity; `position,velocity` empty).
     pub fn joints(&mut self, time: Real, world: &World, labels: &[String]) -> Result<(), Failure> {
         let body_label = labeller(world, labels);
         let label = |id: Option<tumble::BodyId>| id.map_or("world", &body_label);
-        for (k, (_, j)) in world.joints().enumerate() {
+        for (k, (id, j)) in world.joints().enumerate() {
             let (f, t) = (j.reaction_force(), j.reaction_torque());
             let name = j.name().map_or_else(|| k.to_string(), str::to_string);
             self.row(
                 time,
                 format_args!(
-                    "{},{},{},{},{},{},{},{},{},{}",
+                    "{},{},{},{},{},{},{},{},{},{},{}",
                     csv_text(&name),
                     csv_text(label(Some(j.body()))),
                     csv_text(label(j.other())),
@@ -169,7 +197,8 @@ impl CsvFile {
                     Num(t.x),
                     Num(t.y),
                     Num(t.z),
-                    u8::from(j.is_broken())
+                    u8::from(j.is_broken()),
+                    Coordinates(world.joint_position(id).ok(), world.joint_velocity(id).ok())
                 ),
             )?;
         }

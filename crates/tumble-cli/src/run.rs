@@ -74,7 +74,10 @@ pub struct RunArgs {
 
     /// Write every joint of every recorded step as CSV to FILE: time (s), joint (its name
     /// or index), body, other ("world" for none), fx,fy,fz (N) and tx,ty,tz (N·m), the
-    /// force and torque the joint applied to `other` over that step, and broken (0 or 1).
+    /// force and torque the joint applied to `other` over that step, broken (0 or 1), and
+    /// the joint's coordinate and rate: position, velocity (rad, rad/s or m, m/s: hinges,
+    /// sliders, distance joints) or position_x..z, velocity_x..z (ball and fixed joints:
+    /// rotation vector and relative angular velocity in `other`'s frame).
     #[arg(long, value_name = "FILE")]
     pub joints: Option<PathBuf>,
 

@@ -498,15 +498,16 @@ fn joint_reactions_are_written_and_carry_the_load() {
     let mut lines = text.lines();
     assert_eq!(
         lines.next(),
-        Some("time,joint,body,other,fx,fy,fz,tx,ty,tz,broken")
+        Some(
+            "time,joint,body,other,fx,fy,fz,tx,ty,tz,broken,position,velocity,\
+             position_x,position_y,position_z,velocity_x,velocity_y,velocity_z"
+        )
     );
-    let last: Vec<f64> = lines
-        .last()
-        .unwrap()
-        .split(',')
-        .skip(4)
-        .map(|x| x.parse().unwrap())
-        .collect();
+    let fields: Vec<String> = lines.last().unwrap().split(',').map(String::from).collect();
+    // A hinge: its angle and rate in position and velocity, the vector columns empty.
+    assert_eq!(fields.len(), 19);
+    assert!(fields[13..].iter().all(|f| f.is_empty()), "{fields:?}");
+    let last: Vec<f64> = fields[4..13].iter().map(|x| x.parse().unwrap()).collect();
     let weight = 0.9 * 2.0 * 0.04 * 600.0 * 9.8;
     assert!((last[1] + weight).abs() < 1e-3 * weight, "fy {}", last[1]);
     let torque = (last[3] * last[3] + last[4] * last[4] + last[5] * last[5]).sqrt();
@@ -515,4 +516,11 @@ fn joint_reactions_are_written_and_carry_the_load() {
         "torque {torque}"
     );
     assert_eq!(last[6], 0.0, "the hinge broke");
+    // The motor (1 rad/s) has opened it onto its 90° limit, where it rests.
+    assert!(
+        (last[7] - std::f64::consts::FRAC_PI_2).abs() < 0.01,
+        "angle {}",
+        last[7]
+    );
+    assert!(last[8].abs() < 0.05, "rate {}", last[8]);
 }

@@ -17,9 +17,9 @@ use crate::world::{body_arg, checked_name, Inner, PyWorld};
 #[pyclass(module = "tumble", name = "Motor", frozen, get_all)]
 pub struct PyMotor {
     /// Target speed (rad/s for hinges, m/s for sliders).
-    speed: f64,
+    pub(crate) speed: f64,
     /// Largest torque (N·m) or force (N) the motor may exert.
-    max_force: f64,
+    pub(crate) max_force: f64,
 }
 
 #[pymethods]
@@ -40,11 +40,11 @@ impl PyMotor {
 #[pyclass(module = "tumble", name = "JointSpring", frozen, get_all)]
 pub struct PyJointSpring {
     /// Natural frequency (Hz).
-    hertz: f64,
+    pub(crate) hertz: f64,
     /// Damping ratio (1 = critical).
-    damping_ratio: f64,
+    pub(crate) damping_ratio: f64,
     /// Rest angle (rad) or position (m).
-    target: f64,
+    pub(crate) target: f64,
 }
 
 #[pymethods]
@@ -67,17 +67,53 @@ impl PyJointSpring {
     }
 }
 
+/// A position servo on a hinge or slider: drives the joint towards `target` (rad or m)
+/// as a spring of `stiffness` (N·m/rad or N/m) and a damper of `damping` (N·m·s/rad or
+/// N·s/m) would, with at most `max_force` (N·m or N); solved implicitly, stable at any
+/// stiffness.
+#[pyclass(module = "tumble", name = "Servo", frozen, get_all)]
+pub struct PyServo {
+    /// Target angle (rad) or position (m).
+    pub(crate) target: f64,
+    /// Stiffness (N·m/rad or N/m).
+    pub(crate) stiffness: f64,
+    /// Damping (N·m·s/rad or N·s/m).
+    pub(crate) damping: f64,
+    /// Largest torque (N·m) or force (N).
+    pub(crate) max_force: f64,
+}
+
+#[pymethods]
+impl PyServo {
+    #[new]
+    fn new(target: f64, stiffness: f64, damping: f64, max_force: f64) -> Self {
+        PyServo {
+            target,
+            stiffness,
+            damping,
+            max_force,
+        }
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "tumble.Servo({}, {}, {}, {})",
+            self.target, self.stiffness, self.damping, self.max_force
+        )
+    }
+}
+
 /// A joint in a world: its `name`, `kind`, `body` and `other` (None: the world), whether it
 /// is `broken`, and the `reaction_force` (N) and `reaction_torque` (N·m) it applied to
 /// `other` over the last step (`body` felt the opposite).
 #[pyclass(module = "tumble", name = "Joint", frozen)]
 pub struct PyJoint {
-    world: Py<PyWorld>,
-    id: JointId,
+    pub(crate) world: Py<PyWorld>,
+    pub(crate) id: JointId,
 }
 
 impl PyJoint {
-    fn read<R>(&self, f: impl FnOnce(&tumble::Joint) -> R) -> PyResult<R> {
+    pub(crate) fn read<R>(&self, f: impl FnOnce(&tumble::Joint) -> R) -> PyResult<R> {
         let g = self.world.get().lock()?;
         Ok(f(g.world.joint(self.id).map_err(engine)?))
     }
@@ -217,7 +253,7 @@ fn check_keys(spec: &KindSpec, options: Option<&Bound<'_, PyDict>>) -> PyResult<
 }
 
 /// One option's value, read by its shape.
-fn option_value(option: JointOption, o: &Bound<'_, PyAny>) -> PyResult<OptionValue> {
+pub(crate) fn option_value(option: JointOption, o: &Bound<'_, PyAny>) -> PyResult<OptionValue> {
     let key = option.key();
     Ok(match option.shape() {
         OptionShape::Real => {
@@ -247,6 +283,22 @@ fn option_value(option: JointOption, o: &Bound<'_, PyAny>) -> PyResult<OptionVal
                 hertz: real(s.hertz),
                 damping_ratio: real(s.damping_ratio),
                 target: real(s.target),
+            })
+        }
+        OptionShape::Servo => {
+            let s = o.cast::<PyServo>().map_err(|_| {
+                wrong_type(
+                    key,
+                    "a tumble.Servo(target, stiffness, damping, max_force)",
+                    o,
+                )
+            })?;
+            let s = s.get();
+            OptionValue::Servo(tumble::Servo {
+                target: real(s.target),
+                stiffness: real(s.stiffness),
+                damping: real(s.damping),
+                max_force: real(s.max_force),
             })
         }
     })
@@ -294,7 +346,7 @@ impl PyWorld {
     /// out, they are where `body`'s anchor and axis are now, so the joint starts satisfied.
     /// Options by kind (keywords; None counts as left out): ball `cone` (rad) and `twist`
     /// [lo, hi] (rad); hinge and slider `limits` [lo, hi] (rad or m), `motor`
-    /// (tumble.Motor), `spring` (tumble.JointSpring); distance `length`, `min`, `max` (m)
+    /// (tumble.Motor), `spring` (tumble.JointSpring), `servo` (tumble.Servo); distance `length`, `min`, `max` (m)
     /// and `spring`. `collide_connected` lets the two bodies still collide; `break_force`
     /// (N) breaks the joint when exceeded.
     #[pyo3(signature = (kind, body, other = None, *, anchor = None, axis = None,
@@ -380,6 +432,7 @@ impl PyWorld {
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyMotor>()?;
     m.add_class::<PyJointSpring>()?;
+    m.add_class::<PyServo>()?;
     m.add_class::<PyJoint>()?;
     Ok(())
 }

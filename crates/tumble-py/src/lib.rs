@@ -11,6 +11,7 @@
 mod body;
 mod bulk;
 mod convert;
+mod joint_control;
 mod joints;
 mod query;
 mod shapes;

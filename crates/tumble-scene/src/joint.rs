@@ -6,7 +6,7 @@
 //! `[lower, upper]`, a motor object, a spring object). Nothing here names a kind.
 
 use tumble::joint::{JointOptions, KindSpec, OptionShape, OptionValue, JOINT_KINDS};
-use tumble::{BodyId, JointDef, JointKind, JointSpring, Motor, Quat, Real, Vec3, World};
+use tumble::{BodyId, JointDef, JointKind, JointSpring, Motor, Quat, Real, Servo, Vec3, World};
 
 use crate::error::{printable, Result};
 use crate::reader::{Node, Obj};
@@ -96,6 +96,7 @@ fn options(obj: &Obj<'_>, spec: &KindSpec) -> Result<JointKind> {
             OptionShape::Range => range(obj, key)?.map(OptionValue::Range),
             OptionShape::Motor => motor(obj, key, spec.motor_limit_key())?.map(OptionValue::Motor),
             OptionShape::Spring => spring(obj, key)?.map(OptionValue::Spring),
+            OptionShape::Servo => servo(obj, key, spec.motor_limit_key())?.map(OptionValue::Servo),
         };
         if let Some(value) = value {
             // Each value was read by its option's own shape.
@@ -150,6 +151,22 @@ fn spring(obj: &Obj<'_>, key: &str) -> Result<Option<JointSpring>> {
         hertz: s.required("hertz")?.real()?,
         damping_ratio: s.real("damping_ratio")?.unwrap_or(1.0),
         target: s.real("target")?.unwrap_or(0.0),
+    }))
+}
+
+/// `{"target": .., "stiffness": .., "damping": .., "max_torque" | "max_force": ..}`;
+/// `damping` defaults to 0. The numbers are checked by the engine.
+fn servo(obj: &Obj<'_>, key: &str, limit_key: &str) -> Result<Option<Servo>> {
+    let Some(node) = obj.get(key) else {
+        return Ok(None);
+    };
+    let s = node.object()?;
+    s.only(&["target", "stiffness", "damping", limit_key])?;
+    Ok(Some(Servo {
+        target: s.required("target")?.real()?,
+        stiffness: s.required("stiffness")?.real()?,
+        damping: s.real("damping")?.unwrap_or(0.0),
+        max_force: s.required(limit_key)?.real()?,
     }))
 }
 

@@ -210,3 +210,42 @@ fn each_joint_type_takes_exactly_its_described_keys_and_the_docs_list_them() {
         }
     }
 }
+
+#[test]
+fn a_servo_is_read_and_checked_by_its_field_names() {
+    let scene = |servo: &str| {
+        format!(
+            r#"{{"bodies": [{{"name": "arm", "shape": {{"type": "sphere", "radius": 0.1}}}}],
+                 "joints": [{{"type": "hinge", "body": "arm", "axis": [0, 0, 1], "servo": {servo}}}]}}"#
+        )
+    };
+    let s = load_str(&scene(
+        r#"{"target": 0.3, "stiffness": 500, "damping": 20, "max_torque": 50}"#,
+    ))
+    .unwrap();
+    let (_, j) = s.world.joints().next().unwrap();
+    let expect = tumble::Servo {
+        target: 0.3,
+        stiffness: 500.0,
+        damping: 20.0,
+        max_force: 50.0,
+    };
+    assert!(matches!(j.kind(), JointKind::Hinge { servo: Some(s), .. } if *s == expect));
+    for (servo, message) in [
+        (
+            r#"{"target": 0.3, "stiffness": -1, "max_torque": 5}"#,
+            "joints[0].servo.stiffness: must be >= 0",
+        ),
+        (
+            r#"{"target": 0.3, "stiffness": 1, "max_force": 5}"#,
+            "joints[0].servo.max_force: unknown key",
+        ),
+        (
+            r#"{"stiffness": 1, "max_torque": 5}"#,
+            "joints[0].servo.target: missing required key",
+        ),
+    ] {
+        let err = load_str(&scene(servo)).unwrap_err().to_string();
+        assert!(err.starts_with(message), "{err}");
+    }
+}

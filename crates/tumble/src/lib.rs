@@ -40,7 +40,7 @@ pub use force::{
 pub use geometry::{Aabb, Pose, Ray, RayHit};
 pub use id::{BodyId, ForceId};
 pub use integrate::Integrator;
-pub use joint::{Joint, JointDef, JointId, JointKind, JointSpring, Motor};
+pub use joint::{Joint, JointCoordinate, JointDef, JointId, JointKind, JointSpring, Motor, Servo};
 pub use limits::SpeedLimits;
 pub use math::{Mat3, Quat, Real, Vec3};
 pub use narrow_phase::{ContactPoint, Manifold};
@@ -55,7 +55,7 @@ pub mod prelude {
     pub use crate::{
         AppliedForce, Body, BodyDef, BodyId, BodyKind, CompoundChild, Diagnostics, Drag, Error,
         Force, ForceContext, ForceId, InertiaSpec, Integrator, JointDef, JointId, JointKind,
-        JointSpring, MassSpec, Mat3, Motor, Quat, Real, Shape, SolverKind, SolverSettings, Spring,
-        SpringEnd, Vec3, World, WorldDef,
+        JointSpring, MassSpec, Mat3, Motor, Quat, Real, Servo, Shape, SolverKind, SolverSettings,
+        Spring, SpringEnd, Vec3, World, WorldDef,
     };
 }

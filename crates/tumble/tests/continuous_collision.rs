@@ -479,6 +479,7 @@ fn a_door_swinging_fast_on_its_hinge_is_not_stopped_by_its_frame() {
         limits: None,
         motor: None,
         spring: None,
+        servo: None,
     };
     let joint = JointDef {
         anchor: Vec3::new(-0.45, 0.0, 0.0),

@@ -297,6 +297,7 @@ fn values_that_can_only_overflow_are_refused_with_the_limit() {
         limits: None,
         motor: None,
         spring: Some(spring),
+        servo: None,
     };
     let e = w
         .create_joint(&JointDef::new(hinge(spring), ball))

@@ -51,6 +51,7 @@ fn hinge_pendulum(length: Real, angle: Real) -> (World, BodyId, Real, Real) {
             limits: None,
             motor: None,
             spring: None,
+            servo: None,
         },
         ball,
     );
@@ -130,6 +131,7 @@ fn hinge(limits: Option<[Real; 2]>, motor: Option<Motor>) -> JointKind {
         limits,
         motor,
         spring: None,
+        servo: None,
     }
 }
 
@@ -394,6 +396,7 @@ fn a_slider_keeps_its_body_on_the_axis_and_a_weld_holds() {
             limits: None,
             motor: None,
             spring: None,
+            servo: None,
         },
         body,
     );
@@ -614,6 +617,7 @@ fn slider_limits_springs_and_distance_ropes_behave() {
                 damping_ratio: 0.0,
                 target: 0.0,
             }),
+            servo: None,
         },
         body,
     );
@@ -748,6 +752,12 @@ fn every_kind_is_described_and_its_options_round_trip() {
             hertz: 3.0,
             damping_ratio: 0.5,
             target: 0.1,
+        }),
+        servo: Some(Servo {
+            target: 0.2,
+            stiffness: 50.0,
+            damping: 1.0,
+            max_force: 10.0,
         }),
         length: Some(1.5),
         min: Some(0.5),

@@ -293,8 +293,22 @@ class JointSpring:
     target: float
     def __init__(self, hertz: float, damping_ratio: float = 1.0, target: float = 0.0) -> None: ...
 
+class Servo:
+    """A position servo: towards `target` (rad or m) with `stiffness` (N·m/rad or N/m),
+    `damping` (N·m·s/rad or N·s/m) and at most `max_force` (N·m or N), solved implicitly."""
+
+    target: float
+    stiffness: float
+    damping: float
+    max_force: float
+    def __init__(self, target: float, stiffness: float, damping: float, max_force: float) -> None: ...
+
+JointCoordinate = Union[float, Tuple[float, float, float]]
+
 class Joint:
-    """A handle on a joint."""
+    """A handle on a joint. `motor`, `servo`, `limits`, `spring`, `enabled`, `break_force`
+    and `position` are settable while the world runs (checked as `add_joint` checks them;
+    a refused value changes nothing; both bodies are woken)."""
 
     @property
     def name(self) -> Optional[str]: ...
@@ -315,6 +329,46 @@ class Joint:
         """Torque applied to `other` about its anchor over the last step (N·m), (3,)."""
     @property
     def alive(self) -> bool: ...
+    @property
+    def motor(self) -> Optional[Motor]:
+        """The hinge's or slider's velocity motor; None switches it off."""
+    @motor.setter
+    def motor(self, value: Optional[Motor]) -> None: ...
+    @property
+    def servo(self) -> Optional[Servo]:
+        """The hinge's or slider's position servo; None switches it off."""
+    @servo.setter
+    def servo(self, value: Optional[Servo]) -> None: ...
+    @property
+    def limits(self) -> Optional[Tuple[float, float]]:
+        """The hinge's or slider's (lower, upper) limits (rad or m), or None."""
+    @limits.setter
+    def limits(self, value: Optional[Sequence[float]]) -> None: ...
+    @property
+    def spring(self) -> Optional[JointSpring]:
+        """The spring of a hinge, slider or distance joint, or None."""
+    @spring.setter
+    def spring(self, value: Optional[JointSpring]) -> None: ...
+    @property
+    def enabled(self) -> bool:
+        """Whether the joint acts; a disabled joint's bodies collide as unjoined ones."""
+    @enabled.setter
+    def enabled(self, value: bool) -> None: ...
+    @property
+    def break_force(self) -> Optional[float]:
+        """Reaction force (N) beyond which the joint breaks, or None."""
+    @break_force.setter
+    def break_force(self, value: Optional[float]) -> None: ...
+    @property
+    def position(self) -> JointCoordinate:
+        """Hinge angle (rad, in (-pi, pi]), slider offset or distance (m); a ball or fixed
+        joint's rotation vector (rad, in `other`'s frame). Setting it (not on fixed joints)
+        moves one side of the joint rigidly to that coordinate."""
+    @position.setter
+    def position(self, value: Union[float, Vec3Like]) -> None: ...
+    @property
+    def velocity(self) -> JointCoordinate:
+        """The coordinate's rate (rad/s or m/s); ball and fixed: relative angular velocity."""
 
 class World:
     """A simulated world: bodies, force elements, joints and the step."""

@@ -5,7 +5,7 @@
 //! [`JointKind::from_options`]). The solver's rows, the checks, the scene reader's keys and
 //! the Python binding's keywords are all derived from this table.
 
-use super::{JointKind, JointSpring, Motor};
+use super::{JointKind, JointSpring, Motor, Servo};
 use crate::error::{Error, Result};
 use crate::math::Real;
 
@@ -69,6 +69,8 @@ pub enum JointOption {
     Motor,
     /// `spring`: a [`JointSpring`] on the free coordinate.
     Spring,
+    /// `servo`: a [`Servo`] on the free coordinate.
+    Servo,
     /// `length`: rest length, > 0; left out, the anchors' distance at creation.
     Length,
     /// `min`: shortest distance, ≥ 0.
@@ -88,16 +90,19 @@ pub enum OptionShape {
     Motor,
     /// A [`JointSpring`].
     Spring,
+    /// A [`Servo`].
+    Servo,
 }
 
 impl JointOption {
     /// Every option, in the order option errors report them.
-    pub const ALL: [JointOption; 8] = [
+    pub const ALL: [JointOption; 9] = [
         JointOption::Cone,
         JointOption::Twist,
         JointOption::Limits,
         JointOption::Motor,
         JointOption::Spring,
+        JointOption::Servo,
         JointOption::Length,
         JointOption::Min,
         JointOption::Max,
@@ -111,6 +116,7 @@ impl JointOption {
             JointOption::Limits => "limits",
             JointOption::Motor => "motor",
             JointOption::Spring => "spring",
+            JointOption::Servo => "servo",
             JointOption::Length => "length",
             JointOption::Min => "min",
             JointOption::Max => "max",
@@ -126,6 +132,7 @@ impl JointOption {
             JointOption::Twist | JointOption::Limits => OptionShape::Range,
             JointOption::Motor => OptionShape::Motor,
             JointOption::Spring => OptionShape::Spring,
+            JointOption::Servo => OptionShape::Servo,
         }
     }
 }
@@ -179,6 +186,7 @@ pub const JOINT_KINDS: [KindSpec; 5] = [
             opt(JointOption::Limits, "rad"),
             opt(JointOption::Motor, "rad/s, N·m"),
             opt(JointOption::Spring, "rad"),
+            opt(JointOption::Servo, "rad, N·m/rad, N·m·s/rad, N·m"),
         ],
     },
     KindSpec {
@@ -190,6 +198,7 @@ pub const JOINT_KINDS: [KindSpec; 5] = [
             opt(JointOption::Limits, "m"),
             opt(JointOption::Motor, "m/s, N"),
             opt(JointOption::Spring, "m"),
+            opt(JointOption::Servo, "m, N/m, N·s/m, N"),
         ],
     },
     KindSpec {
@@ -246,6 +255,8 @@ pub enum OptionValue {
     Motor(Motor),
     /// For [`OptionShape::Spring`].
     Spring(JointSpring),
+    /// For [`OptionShape::Servo`].
+    Servo(Servo),
 }
 
 /// Every option's value, `None` where not given: a kind's settings in one shape.
@@ -257,6 +268,7 @@ pub struct JointOptions {
     pub limits: Option<[Real; 2]>,
     pub motor: Option<Motor>,
     pub spring: Option<JointSpring>,
+    pub servo: Option<Servo>,
     pub length: Option<Real>,
     pub min: Option<Real>,
     pub max: Option<Real>,
@@ -271,6 +283,7 @@ impl JointOptions {
             JointOption::Limits => self.limits.map(OptionValue::Range),
             JointOption::Motor => self.motor.map(OptionValue::Motor),
             JointOption::Spring => self.spring.map(OptionValue::Spring),
+            JointOption::Servo => self.servo.map(OptionValue::Servo),
             JointOption::Length => self.length.map(OptionValue::Real),
             JointOption::Min => self.min.map(OptionValue::Real),
             JointOption::Max => self.max.map(OptionValue::Real),
@@ -285,6 +298,7 @@ impl JointOptions {
             (JointOption::Limits, OptionValue::Range(r)) => self.limits = Some(r),
             (JointOption::Motor, OptionValue::Motor(m)) => self.motor = Some(m),
             (JointOption::Spring, OptionValue::Spring(s)) => self.spring = Some(s),
+            (JointOption::Servo, OptionValue::Servo(s)) => self.servo = Some(s),
             (JointOption::Length, OptionValue::Real(x)) => self.length = Some(x),
             (JointOption::Min, OptionValue::Real(x)) => self.min = Some(x),
             (JointOption::Max, OptionValue::Real(x)) => self.max = Some(x),
@@ -294,6 +308,7 @@ impl JointOptions {
                     OptionShape::Range => "[lower, upper]",
                     OptionShape::Motor => "a motor",
                     OptionShape::Spring => "a spring",
+                    OptionShape::Servo => "a servo",
                 };
                 return Err(Error::invalid(option.key(), format!("expected {expected}")));
             }
@@ -333,12 +348,14 @@ impl JointKind {
                 limits,
                 motor,
                 spring,
+                servo,
             } => (
                 &JOINT_KINDS[1],
                 JointOptions {
                     limits,
                     motor,
                     spring,
+                    servo,
                     ..none
                 },
             ),
@@ -346,12 +363,14 @@ impl JointKind {
                 limits,
                 motor,
                 spring,
+                servo,
             } => (
                 &JOINT_KINDS[2],
                 JointOptions {
                     limits,
                     motor,
                     spring,
+                    servo,
                     ..none
                 },
             ),
@@ -386,11 +405,13 @@ impl JointKind {
                 limits: o.limits,
                 motor: o.motor,
                 spring: o.spring,
+                servo: o.servo,
             },
             "slider" => JointKind::Slider {
                 limits: o.limits,
                 motor: o.motor,
                 spring: o.spring,
+                servo: o.servo,
             },
             "fixed" => JointKind::Fixed,
             "distance" => JointKind::Distance {

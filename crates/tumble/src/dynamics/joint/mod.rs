@@ -24,8 +24,10 @@ use crate::id::BodyId;
 pub use crate::id::JointId;
 use crate::limits::MAX_COORDINATE;
 
+pub(crate) mod coords;
 mod kinds;
 use crate::math::{orthonormal_basis, Quat, Real, Vec3};
+pub use coords::JointCoordinate;
 pub use kinds::{
     AngularLock, FreeAxis, JointOption, JointOptions, KindSpec, LinearLock, OptionShape,
     OptionSpec, OptionValue, JOINT_KINDS,
@@ -53,6 +55,25 @@ pub struct JointSpring {
     pub target: Real,
 }
 
+/// A position servo: drives the joint's free coordinate towards `target` as a spring of
+/// `stiffness` and a damper of `damping` would (τ = −k (q − target) − c q̇), solved
+/// implicitly in each substep (stable at any stiffness), with at most `max_force`. Unlike
+/// a [`JointSpring`], whose stiffness follows from a frequency and the bodies' masses,
+/// the gains are given as torque (force) per radian (metre): a load τ holds the joint
+/// off its target by about τ / k (less, by up to half, as the solver's passes share the
+/// load with the joint's other rows; see `solver/joint_1d.rs`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Servo {
+    /// Target angle (rad) or position (m) of the free coordinate.
+    pub target: Real,
+    /// Stiffness k (N·m/rad for hinges, N/m for sliders), ≥ 0.
+    pub stiffness: Real,
+    /// Damping c (N·m·s/rad for hinges, N·s/m for sliders), ≥ 0; k and c not both 0.
+    pub damping: Real,
+    /// Largest torque (N·m) or force (N) the servo may exert, ≥ 0.
+    pub max_force: Real,
+}
+
 /// What a joint constrains, with the settings particular to each kind.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum JointKind {
@@ -72,6 +93,8 @@ pub enum JointKind {
         motor: Option<Motor>,
         /// Spring about the axis.
         spring: Option<JointSpring>,
+        /// Position servo about the axis.
+        servo: Option<Servo>,
     },
     /// No relative rotation; the anchors move apart only along the axis.
     Slider {
@@ -81,6 +104,8 @@ pub enum JointKind {
         motor: Option<Motor>,
         /// Spring along the axis.
         spring: Option<JointSpring>,
+        /// Position servo along the axis.
+        servo: Option<Servo>,
     },
     /// No relative motion at all (a weld).
     Fixed,
@@ -163,6 +188,9 @@ pub struct Joint {
     /// Rest length of a distance joint (m).
     pub(crate) length: Real,
     pub(crate) broken: bool,
+    /// Cleared by `World::set_joint_enabled(id, false)`: a disabled joint is not solved and
+    /// keeps no pair from colliding, as a broken one.
+    pub(crate) enabled: bool,
     pub(crate) reaction_force: Vec3,
     pub(crate) reaction_torque: Vec3,
     /// Impulses of the last substep, to warm-start the next.
@@ -182,6 +210,7 @@ pub(crate) struct JointImpulses {
     pub cone: Real,
     pub motor: Real,
     pub spring: Real,
+    pub servo: Real,
     /// Rigid distance row.
     pub axial: Real,
 }
@@ -210,6 +239,14 @@ impl Joint {
     /// Whether the reaction passed `break_force`: a broken joint no longer acts.
     pub fn is_broken(&self) -> bool {
         self.broken
+    }
+    /// Whether the joint is enabled (see `World::set_joint_enabled`).
+    pub fn is_enabled(&self) -> bool {
+        self.enabled
+    }
+    /// Whether the joint acts: enabled and not broken.
+    pub(crate) fn acts(&self) -> bool {
+        self.enabled && !self.broken
     }
     /// The force the joint applied to `other` over the last step (N, world frame); the
     /// force on `body` is its opposite.
@@ -267,6 +304,7 @@ fn check_option(option: JointOption, value: OptionValue, options: &JointOptions)
             check::non_negative(&format!("{key}.max_force"), m.max_force)
         }
         (_, OptionValue::Spring(sp)) => check_spring(key, &sp),
+        (_, OptionValue::Servo(sv)) => check_servo(key, &sv),
         (_, OptionValue::Real(x)) => check::finite(key, x),
     }
 }
@@ -292,6 +330,18 @@ fn check_spring(field: &str, s: &JointSpring) -> Result<()> {
         "",
     )?;
     check::finite(&format!("{field}.target"), s.target)
+}
+
+fn check_servo(field: &str, s: &Servo) -> Result<()> {
+    check::finite(&format!("{field}.target"), s.target)?;
+    let stiffness = format!("{field}.stiffness");
+    check::non_negative(&stiffness, s.stiffness)?;
+    check::non_negative(&format!("{field}.damping"), s.damping)?;
+    check::non_negative(&format!("{field}.max_force"), s.max_force)?;
+    if s.stiffness == 0.0 && s.damping == 0.0 {
+        return Err(Error::invalid(stiffness, "must be > 0 when damping is 0"));
+    }
+    Ok(())
 }
 
 /// Builds the world's record of a checked definition, given the bodies' poses now
@@ -322,6 +372,7 @@ pub(crate) fn build(def: &JointDef, body: (Vec3, Quat), other: Option<(Vec3, Qua
         relative_rotation: qa.inverse() * qb,
         length,
         broken: false,
+        enabled: true,
         reaction_force: Vec3::ZERO,
         reaction_torque: Vec3::ZERO,
         impulses: JointImpulses::default(),

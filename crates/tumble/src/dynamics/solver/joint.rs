@@ -347,7 +347,7 @@ impl JointConstraint {
         joint.impulses = self.impulses;
         joint.reaction_force = self.total_linear / dt;
         joint.reaction_torque = self.total_angular / dt;
-        if let Some(limit) = joint.def.break_force {
+        if let Some(limit) = joint.def.break_force.filter(|_| joint.enabled) {
             if joint.reaction_force.length() > limit {
                 joint.broken = true;
                 joint.impulses = JointImpulses::default();

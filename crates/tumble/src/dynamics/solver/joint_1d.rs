@@ -3,6 +3,8 @@
 //!
 //! ```text
 //! spring  soft at its own hertz/damping:   Δλ = −m·mass_scale·(Jv + bias_rate·(x − target)) − impulse_scale·λ
+//! servo   implicit spring k and damper c towards its target, |λ| ≤ max_force·h:
+//!         Δλ = −(Jv + k/(c + h k)·(x − target)) / (K + 1/(h(c + h k))) − λ/(1 + h(c + h k)·K)
 //! motor   towards its speed, |λ| ≤ max_force·h:   Δλ = −m·(Jv − speed)
 //! limit   one-sided, λ ≥ 0, keeps margin ≥ 0: speculative (bias margin/h, rigid) while
 //!         the margin is positive, the joint softness once violated
@@ -13,7 +15,7 @@
 //! follows from its options ([`FreeDrive::of`]).
 
 use super::{Frame, JointPass, Row};
-use crate::dynamics::joint::{FreeAxis, JointImpulses, JointOptions, JointSpring, Motor};
+use crate::dynamics::joint::{FreeAxis, JointImpulses, JointOptions, JointSpring, Motor, Servo};
 use crate::dynamics::solver::body::BodyState;
 use crate::dynamics::solver::softness::Softness;
 use crate::math::Real;
@@ -51,7 +53,13 @@ pub(super) fn solve_limit(
 /// The impulse along the free coordinate's row: limits (the upper one's row is negated),
 /// motor, spring and rod.
 pub(super) fn free_impulse(imp: &JointImpulses) -> Real {
-    imp.lower - imp.upper + imp.motor + imp.spring + imp.axial
+    let sum = imp.lower - imp.upper + imp.motor + imp.spring + imp.axial;
+    // Added only when there is one: a +0 added to a −0 sum would change recorded results.
+    if imp.servo != 0.0 {
+        sum + imp.servo
+    } else {
+        sum
+    }
 }
 
 /// What acts on a joint's free coordinate, from its options: the limits (`limits`, a
@@ -63,6 +71,7 @@ pub(super) struct FreeDrive {
     limits: Option<[Real; 2]>,
     motor: Option<Motor>,
     spring: Option<JointSpring>,
+    servo: Option<Servo>,
     rod: Option<Real>,
 }
 
@@ -88,17 +97,22 @@ impl FreeDrive {
             limits: o.limits.or(o.twist).or(range),
             motor: o.motor,
             spring,
+            servo: o.servo,
             rod: rigid.then_some(rest),
         }
     }
 
     /// Whether nothing acts on the free coordinate.
     pub fn is_idle(&self) -> bool {
-        self.limits.is_none() && self.motor.is_none() && self.spring.is_none() && self.rod.is_none()
+        self.limits.is_none()
+            && self.motor.is_none()
+            && self.spring.is_none()
+            && self.servo.is_none()
+            && self.rod.is_none()
     }
 }
 
-/// Spring, motor, limits and (distance joints) the rigid rod along the free coordinate.
+/// Spring, servo, motor, limits and (distance joints) the rigid rod along the free coordinate.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn solve_free(
     drive: &FreeDrive,
@@ -112,6 +126,14 @@ pub(super) fn solve_free(
 ) {
     if let Some(s) = drive.spring {
         imp.spring = solve_spring(row, coordinate, &s, imp.spring, fr, pass, a, b);
+    }
+    // Solved in both passes, as the frequency spring is. Its row's mass is the free
+    // coordinate's own (a hinge: the body's inertia about its centre, not the pivot's),
+    // and the hard rows solved after it carry the load's torque around to it, so the
+    // static stiffness is only near k (measured: a hinged arm sagged 0.67 τ/k at k = 5000
+    // N·m/rad, 0.83 τ/k at 500); solved once a substep it came out 0.36 τ/k.
+    if let Some(s) = drive.servo {
+        imp.servo = solve_servo(row, coordinate, &s, imp.servo, fr, pass, a, b);
     }
     if let Some(m) = drive.motor {
         imp.motor = solve_motor(row, &m, imp.motor, fr, pass, a, b);
@@ -182,6 +204,38 @@ fn solve_motor(
 ) -> Real {
     let limit = motor.max_force * pass.h;
     let delta = -row.mass(&fr.sa, &fr.sb) * (row.velocity(a, b) - motor.speed);
+    let total = (acc + delta).clamp(-limit, limit);
+    row.apply(total - acc, &fr.sa, &fr.sb, a, b);
+    total
+}
+
+/// The servo as an implicit spring–damper with a force cap. Backward Euler over the
+/// substep h, for a row of inverse effective mass K = J M⁻¹ Jᵀ: the impulse λ = h F with
+/// F = −k (x + h v⁺ − target) − c v⁺ and v⁺ = v + K λ gives, with s = h (c + h k),
+/// λ = −(v + k/(c + h k)·(x − target)) / (K + 1/s); in the soft-step form (the same as
+/// `Softness`, with the gains given instead of derived from a frequency) the accumulated
+/// impulse enters scaled by 1/(1 + s K). Stable for any k, c ≥ 0.
+#[allow(clippy::too_many_arguments)]
+fn solve_servo(
+    row: Row,
+    coordinate: Real,
+    servo: &Servo,
+    acc: Real,
+    fr: &Frame,
+    pass: &JointPass,
+    a: &mut BodyState,
+    b: &mut BodyState,
+) -> Real {
+    let mass = row.mass(&fr.sa, &fr.sb);
+    let s = pass.h * (servo.damping + pass.h * servo.stiffness);
+    if mass <= 0.0 || s <= 0.0 {
+        return acc;
+    }
+    let k_inv = 1.0 / mass;
+    let bias = servo.stiffness / (servo.damping + pass.h * servo.stiffness);
+    let delta = -(row.velocity(a, b) + bias * (coordinate - servo.target)) / (k_inv + 1.0 / s)
+        - acc / (1.0 + s * k_inv);
+    let limit = servo.max_force * pass.h;
     let total = (acc + delta).clamp(-limit, limit);
     row.apply(total - acc, &fr.sa, &fr.sb, a, b);
     total

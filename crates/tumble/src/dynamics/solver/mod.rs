@@ -435,8 +435,8 @@ impl Solver {
             joints
                 .iter()
                 .zip(joint_bodies)
-                .filter_map(|(j, link)| match (j.broken, *link) {
-                    (false, [Some(a), Some(b)]) => Some((a, b)),
+                .filter_map(|(j, link)| match (j.acts(), *link) {
+                    (true, [Some(a), Some(b)]) => Some((a, b)),
                     _ => None,
                 });
         (self.heavy, self.heavy_passes) =
@@ -568,7 +568,7 @@ impl Solver {
         self.joints.clear();
 
         for (i, (joint, link)) in joints.iter().zip(links).enumerate() {
-            if joint.broken {
+            if !joint.acts() {
                 continue;
             }
             let center = |k: Option<usize>| k.map_or(Vec3::ZERO, |k| bodies[k].local_center);

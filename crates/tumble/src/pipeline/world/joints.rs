@@ -105,7 +105,8 @@ impl World {
         }
     }
 
-    /// Re-derives each joint's dense body indices (broken joints join nothing) and the
+    /// Re-derives each joint's dense body indices (broken and disabled joints join
+    /// nothing) and the
     /// pairs that must not collide.
     pub(crate) fn refresh_joint_links(&mut self) {
         let links: Vec<[Option<usize>; 2]> = self
@@ -113,7 +114,7 @@ impl World {
             .list
             .iter()
             .map(|j| {
-                if j.broken {
+                if !j.acts() {
                     [None, None]
                 } else {
                     [
@@ -140,6 +141,6 @@ impl World {
 }
 
 /// The error for a handle naming no live joint.
-fn unknown(id: JointId) -> Error {
+pub(super) fn unknown(id: JointId) -> Error {
     Error::invalid("joint", format!("unknown or removed joint {id:?}"))
 }

@@ -23,6 +23,8 @@ mod bodies;
 pub mod bulk;
 mod forces;
 mod invariant;
+mod joint_coords;
+mod joint_edit;
 mod joints;
 pub mod query;
 pub(crate) mod step;
