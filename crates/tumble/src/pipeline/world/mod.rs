@@ -24,6 +24,7 @@ pub mod bulk;
 mod forces;
 mod invariant;
 mod joints;
+mod properties;
 pub mod query;
 pub(crate) mod step;
 
