@@ -285,6 +285,21 @@ fn a_bad_scene_file_is_one_line_naming_the_field() {
         refused(&["run", path(&file)]),
         "bodies[3].shape.radius: must be > 0"
     );
+    // Issue 17's body keys are refused the same way.
+    for (key, value, rule) in [
+        ("linear_damping", "-1", "must be >= 0"),
+        ("angular_damping", "-0.5", "must be >= 0"),
+        ("gravity_scale", "1e7", "must be at most 1e6 in magnitude"),
+    ] {
+        let one = format!(
+            r#"{{"bodies": [{{"shape": {{"type": "sphere", "radius": 1}}, "{key}": {value}}}]}}"#
+        );
+        std::fs::write(&file, one).unwrap();
+        assert_eq!(
+            refused(&["run", path(&file)]),
+            format!("bodies[0].{key}: {rule}")
+        );
+    }
     std::fs::write(&file, "{\"bodies\": [,]}").unwrap();
     assert_eq!(
         refused(&["run", path(&file)]),

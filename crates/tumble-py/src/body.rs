@@ -6,11 +6,13 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use tumble::{Body, BodyId, BodyKind};
 
-use crate::convert::{engine, mat3_out, quat, quat_out, vec3, vec3_out, wide};
+use crate::convert::{engine, layer_bits, mat3_out, quat, quat_out, real, vec3, vec3_out, wide};
 use crate::world::{Inner, PyWorld};
 
 /// A body in a world. Its properties read the live state (arrays are fresh copies); the
-/// assignable ones (position, orientation, velocity, angular_velocity) edit it. Handles of
+/// assignable ones (position, orientation, velocity, angular_velocity, friction,
+/// restitution, collision_group, collision_mask, linear_damping, angular_damping,
+/// gravity_scale) edit it, checked as `add_body` checks them, and wake it. Handles of
 /// a removed body raise ValueError. Two handles of the same body compare equal.
 #[pyclass(module = "tumble", name = "Body", frozen)]
 pub struct PyBody {
@@ -185,16 +187,107 @@ impl PyBody {
         self.read(Body::is_planar)
     }
 
-    /// Coulomb friction coefficient.
+    /// Coulomb friction coefficient (>= 0; a pair uses √(μ_a μ_b)); assignable.
     #[getter]
     fn friction(&self) -> PyResult<f64> {
         self.read(|b| wide(b.friction()))
     }
 
-    /// Coefficient of restitution.
+    #[setter]
+    fn set_friction(&self, value: f64) -> PyResult<()> {
+        self.edit(|g, id| g.world.set_friction(id, real(value)))
+    }
+
+    /// Coefficient of restitution (in [0, 1]; a pair uses the larger); assignable.
     #[getter]
     fn restitution(&self) -> PyResult<f64> {
         self.read(|b| wide(b.restitution()))
+    }
+
+    #[setter]
+    fn set_restitution(&self, value: f64) -> PyResult<()> {
+        self.edit(|g, id| g.world.set_restitution(id, real(value)))
+    }
+
+    /// Collision layers the body is in (32-bit set); assignable.
+    #[getter]
+    fn collision_group(&self) -> PyResult<u32> {
+        self.read(|b| b.collision_filter().0)
+    }
+
+    #[setter]
+    fn set_collision_group(&self, value: i64) -> PyResult<()> {
+        let group = layer_bits(value, "collision_group")?;
+        self.edit(|g, id| {
+            let (_, mask) = g.world.body(id)?.collision_filter();
+            g.world.set_collision_filter(id, group, mask)
+        })
+    }
+
+    /// Layers the body collides with (32-bit set); assignable.
+    #[getter]
+    fn collision_mask(&self) -> PyResult<u32> {
+        self.read(|b| b.collision_filter().1)
+    }
+
+    #[setter]
+    fn set_collision_mask(&self, value: i64) -> PyResult<()> {
+        let mask = layer_bits(value, "collision_mask")?;
+        self.edit(|g, id| {
+            let (group, _) = g.world.body(id)?.collision_filter();
+            g.world.set_collision_filter(id, group, mask)
+        })
+    }
+
+    /// Linear damping (1/s, >= 0): dv/dt = −c v besides the forces; assignable.
+    #[getter]
+    fn linear_damping(&self) -> PyResult<f64> {
+        self.read(|b| wide(b.linear_damping()))
+    }
+
+    #[setter]
+    fn set_linear_damping(&self, value: f64) -> PyResult<()> {
+        self.edit(|g, id| g.world.set_linear_damping(id, real(value)))
+    }
+
+    /// Angular damping (1/s, >= 0): dL/dt = −c L besides the torques; assignable.
+    #[getter]
+    fn angular_damping(&self) -> PyResult<f64> {
+        self.read(|b| wide(b.angular_damping()))
+    }
+
+    #[setter]
+    fn set_angular_damping(&self, value: f64) -> PyResult<()> {
+        self.edit(|g, id| g.world.set_angular_damping(id, real(value)))
+    }
+
+    /// Multiplier of the world's gravity for this body; assignable.
+    #[getter]
+    fn gravity_scale(&self) -> PyResult<f64> {
+        self.read(|b| wide(b.gravity_scale()))
+    }
+
+    #[setter]
+    fn set_gravity_scale(&self, value: f64) -> PyResult<()> {
+        self.edit(|g, id| g.world.set_gravity_scale(id, real(value)))
+    }
+
+    /// Makes a kinematic body arrive exactly at `position` (m, its frame's origin) and
+    /// `orientation` ([x, y, z, w]; default: as it is) at the end of the next step, whose
+    /// dt sets its velocities; it keeps them afterwards. ValueError for a body that is
+    /// not kinematic.
+    #[pyo3(signature = (position, orientation = None))]
+    fn set_kinematic_target(
+        &self,
+        position: &Bound<'_, PyAny>,
+        orientation: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let p = vec3(position, "position")?;
+        let q = match orientation {
+            Some(q) => quat(q, "orientation")?,
+            None => self.read(Body::orientation)?,
+        };
+        self.edit(|g, id| g.world.set_kinematic_target(id, p, q))
     }
 
     /// Rolling resistance coefficient (dimensionless): rolling torque at most μ_r r N.

@@ -410,14 +410,15 @@ impl PyWorld {
     /// to the xy plane; `friction`, `restitution`, `rolling_resistance` (dimensionless:
     /// rolling torque at most μ_r r N) and `torsional_friction` (m: spinning torque at most
     /// μ_t N; a pair uses the larger of each), `collision_group`/`collision_mask`
-    /// (32-bit layer sets) and `bullet` (continuous collision against every body that is
-    /// not a bullet).
+    /// (32-bit layer sets), `bullet` (continuous collision against every body that is
+    /// not a bullet), `linear_damping` and `angular_damping` (1/s: dv/dt = −c v,
+    /// dL/dt = −c L besides the forces) and `gravity_scale` (times the world's gravity).
     #[pyo3(signature = (shape, *, mass = None, density = None, position = None,
         orientation = None, velocity = None, angular_velocity = None,
         kind = "dynamic".to_string(), name = None, planar = false, inertia = None,
         center_of_mass = None, friction = 0.6, restitution = 0.0, rolling_resistance = 0.0,
         torsional_friction = 0.0, collision_group = 1, collision_mask = 0xFFFF_FFFF,
-        bullet = false))]
+        bullet = false, linear_damping = 0.0, angular_damping = 0.0, gravity_scale = 1.0))]
     #[allow(clippy::too_many_arguments)]
     fn add_body<'py>(
         slf: &Bound<'py, Self>,
@@ -440,6 +441,9 @@ impl PyWorld {
         collision_group: i64,
         collision_mask: i64,
         bullet: bool,
+        linear_damping: f64,
+        angular_damping: f64,
+        gravity_scale: f64,
     ) -> PyResult<Bound<'py, PyBody>> {
         let shape = shape_of(shape, "shape")?;
         let mass = match (mass, density) {
@@ -480,6 +484,9 @@ impl PyWorld {
             rolling_resistance: real(rolling_resistance),
             torsional_friction: real(torsional_friction),
             bullet,
+            linear_damping: real(linear_damping),
+            angular_damping: real(angular_damping),
+            gravity_scale: real(gravity_scale),
         };
         let id = slf
             .get()

@@ -5,7 +5,7 @@ use tumble::{BodyDef, BodyKind, InertiaSpec, MassSpec, Mat3, Quat, Shape, Vec3};
 use crate::error::{printable, Result};
 use crate::reader::{Node, Obj};
 
-const BODY_KEYS: [&str; 20] = [
+const BODY_KEYS: [&str; 23] = [
     "name",
     "kind",
     "shape",
@@ -26,6 +26,9 @@ const BODY_KEYS: [&str; 20] = [
     "torsional_friction",
     "bullet",
     "color",
+    "linear_damping",
+    "angular_damping",
+    "gravity_scale",
 ];
 
 /// A body's `color`, `"#rrggbb"`: for pictures and the viewer only, never for physics.
@@ -73,6 +76,9 @@ pub(crate) fn body(node: &Node<'_>) -> Result<(BodyDef, Shape)> {
         rolling_resistance: obj.real("rolling_resistance")?.unwrap_or(0.0),
         torsional_friction: obj.real("torsional_friction")?.unwrap_or(0.0),
         bullet: obj.bool("bullet")?.unwrap_or(false),
+        linear_damping: obj.real("linear_damping")?.unwrap_or(0.0),
+        angular_damping: obj.real("angular_damping")?.unwrap_or(0.0),
+        gravity_scale: obj.real("gravity_scale")?.unwrap_or(1.0),
     };
     let shape = crate::shape::shape(&obj.required("shape")?)?;
     Ok((def, shape))

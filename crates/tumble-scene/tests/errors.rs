@@ -47,7 +47,7 @@ fn misspelt_keys_are_refused_with_the_allowed_ones() {
         "bodies[0].velocty: unknown key (expected one of: name, kind, shape, mass, density, \
          inertia, center_of_mass, position, orientation, velocity, angular_velocity, planar, \
          collision_group, collision_mask, friction, restitution, rolling_resistance, \
-         torsional_friction, bullet, color)"
+         torsional_friction, bullet, color, linear_damping, angular_damping, gravity_scale)"
     );
     assert_eq!(
         error(&with_forces(
@@ -388,8 +388,13 @@ fn solver_passes_state_one_rule_for_every_bad_count() {
 }
 
 #[test]
-fn rolling_resistance_and_torsional_friction_are_checked_with_their_paths() {
-    for key in ["rolling_resistance", "torsional_friction"] {
+fn body_coefficients_are_checked_with_their_paths() {
+    for key in [
+        "rolling_resistance",
+        "torsional_friction",
+        "linear_damping",
+        "angular_damping",
+    ] {
         assert_eq!(
             error(&one_body(&format!(r#""{key}": -0.1"#))),
             format!("bodies[0].{key}: must be >= 0")
@@ -413,6 +418,19 @@ fn rolling_resistance_and_torsional_friction_are_checked_with_their_paths() {
         );
         assert_eq!(error(&two), format!("bodies[1].{key}: must be >= 0"));
     }
+}
+
+#[test]
+fn gravity_scale_is_checked_with_its_path() {
+    assert_eq!(
+        error(&one_body(r#""gravity_scale": 2e6"#)),
+        "bodies[0].gravity_scale: must be at most 1e6 in magnitude"
+    );
+    assert_eq!(
+        error(&one_body(r#""gravity_scale": "1""#)),
+        "bodies[0].gravity_scale: expected a number"
+    );
+    assert!(load_str(&one_body(r#""gravity_scale": -0.5"#)).is_ok());
 }
 
 #[test]

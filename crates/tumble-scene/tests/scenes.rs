@@ -79,6 +79,18 @@ fn the_documented_example_loads_key_for_key() {
 }
 
 #[test]
+fn damping_and_gravity_scale_are_read() {
+    let scene = load(
+        r#"{"bodies": [{"shape": {"type": "sphere", "radius": 0.1},
+            "linear_damping": 0.5, "angular_damping": 2, "gravity_scale": -0.25}]}"#,
+    );
+    let (_, body) = scene.world.bodies().next().unwrap();
+    assert_eq!(body.linear_damping(), 0.5);
+    assert_eq!(body.angular_damping(), 2.0);
+    assert_eq!(body.gravity_scale(), -0.25);
+}
+
+#[test]
 fn omitted_keys_take_their_defaults() {
     let scene = load(r#"{"bodies": [{"shape": {"type": "sphere", "radius": 0.1}}]}"#);
     assert_eq!((scene.dt, scene.duration), (0.01, 1.0));
@@ -89,6 +101,8 @@ fn omitted_keys_take_their_defaults() {
     assert_eq!(body.kind(), BodyKind::Dynamic);
     assert_eq!(body.position(), Vec3::ZERO);
     assert_eq!(body.linear_velocity(), Vec3::ZERO);
+    let damping = (body.linear_damping(), body.angular_damping());
+    assert_eq!((damping, body.gravity_scale()), ((0.0, 0.0), 1.0));
     // Water: 1000 kg/m³ over the ball's volume.
     let volume = 4.0 / 3.0 * tumble::math::PI * 0.1 * 0.1 * 0.1;
     assert!(close(body.mass(), 1000.0 * volume));

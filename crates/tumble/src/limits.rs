@@ -32,6 +32,8 @@ pub const MAX_MOMENT: Real = 1e30;
 pub const MAX_HERTZ: Real = 1e6;
 /// Largest accepted damping ratio (1 is critical).
 pub const MAX_DAMPING_RATIO: Real = 1e6;
+/// Largest accepted |gravity_scale| of a body: a million times the world's gravity.
+pub const MAX_GRAVITY_SCALE: Real = 1e6;
 /// Largest accepted magnitude of any other coefficient: stiffness (N/m), damping (N·s/m),
 /// forces (N), impulses (N·s), torques, drag and motor limits.
 pub const MAX_MAGNITUDE: Real = 1e15;

@@ -158,6 +158,22 @@ pub fn quat_from_rotation_vector(theta: Vec3) -> Quat {
     }
 }
 
+/// The rotation vector (axis times angle, rad) of the unit quaternion `q`, the short way:
+/// the angle is at most π (q and −q are the same rotation). The inverse of
+/// [`quat_from_rotation_vector`].
+#[inline]
+pub fn rotation_vector(q: Quat) -> Vec3 {
+    let q = if q.w < 0.0 { -q } else { q };
+    let v = Vec3::new(q.x, q.y, q.z);
+    let s = v.length();
+    if s < 1e-8 {
+        // angle / s = 2 atan2(s, w) / s = (2 / w)(1 − s²/(3w²) + ...): the first term is
+        // exact to rounding here.
+        return v * (2.0 / q.w);
+    }
+    v * (2.0 * s.atan2(q.w) / s)
+}
+
 /// True when every component is finite.
 #[inline]
 pub fn vec3_is_finite(v: Vec3) -> bool {

@@ -98,7 +98,7 @@ class HeightField(Shape):
     def __init__(self, heights: npt.ArrayLike, scale: Optional[Vec3Like] = None) -> None: ...
 
 class Body:
-    """A handle on a body; properties read the live state, four are assignable."""
+    """A handle on a body; properties read the live state, eleven are assignable."""
 
     @property
     def world(self) -> World:
@@ -164,10 +164,43 @@ class Body:
         """Whether the body is confined to the xy plane."""
     @property
     def friction(self) -> float:
-        """Coulomb friction coefficient."""
+        """Coulomb friction coefficient (>= 0); assignable."""
+    @friction.setter
+    def friction(self, value: float) -> None: ...
     @property
     def restitution(self) -> float:
-        """Coefficient of restitution."""
+        """Coefficient of restitution (in [0, 1]); assignable."""
+    @restitution.setter
+    def restitution(self, value: float) -> None: ...
+    @property
+    def collision_group(self) -> int:
+        """Collision layers the body is in (32-bit set); assignable."""
+    @collision_group.setter
+    def collision_group(self, value: int) -> None: ...
+    @property
+    def collision_mask(self) -> int:
+        """Layers the body collides with (32-bit set); assignable."""
+    @collision_mask.setter
+    def collision_mask(self, value: int) -> None: ...
+    @property
+    def linear_damping(self) -> float:
+        """Linear damping (1/s): dv/dt = −c v besides the forces; assignable."""
+    @linear_damping.setter
+    def linear_damping(self, value: float) -> None: ...
+    @property
+    def angular_damping(self) -> float:
+        """Angular damping (1/s): dL/dt = −c L besides the torques; assignable."""
+    @angular_damping.setter
+    def angular_damping(self, value: float) -> None: ...
+    @property
+    def gravity_scale(self) -> float:
+        """Multiplier of the world's gravity for this body; assignable."""
+    @gravity_scale.setter
+    def gravity_scale(self, value: float) -> None: ...
+    def set_kinematic_target(
+        self, position: Vec3Like, orientation: Optional[QuatLike] = None
+    ) -> None:
+        """A kinematic body arrives exactly at this pose at the end of the next step (then keeps its velocities)."""
     @property
     def rolling_resistance(self) -> float:
         """Rolling resistance coefficient (dimensionless): rolling torque at most μ_r r N."""
@@ -423,6 +456,9 @@ class World:
         collision_group: int = 1,
         collision_mask: int = 0xFFFFFFFF,
         bullet: bool = False,
+        linear_damping: float = 0.0,
+        angular_damping: float = 0.0,
+        gravity_scale: float = 1.0,
     ) -> Body:
         """Adds a body and returns its handle."""
     def remove_body(self, body: BodyLike) -> None:

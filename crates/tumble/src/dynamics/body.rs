@@ -107,6 +107,15 @@ pub struct BodyDef {
     /// Continuous collision against every body that is not a bullet, not only static ones,
     /// for fast projectiles (swept after the other fast bodies, along their motion).
     pub bullet: bool,
+    /// Linear damping c (1/s, finite, >= 0): besides the forces, dv/dt = −c v, so a free
+    /// body's velocity decays as exp(−c t). Default 0: none, at no cost.
+    pub linear_damping: Real,
+    /// Angular damping c (1/s, finite, >= 0): dL/dt = −c L besides the torques, which at
+    /// fixed orientation is dω/dt = −c ω. Default 0.
+    pub angular_damping: Real,
+    /// Multiplier of the world's gravity for this body (dimensionless, finite, |s| <=
+    /// `limits::MAX_GRAVITY_SCALE`; negative rises). Default 1.
+    pub gravity_scale: Real,
 }
 
 impl Default for BodyDef {
@@ -129,6 +138,9 @@ impl Default for BodyDef {
             rolling_resistance: 0.0,
             torsional_friction: 0.0,
             bullet: false,
+            linear_damping: 0.0,
+            angular_damping: 0.0,
+            gravity_scale: 1.0,
         }
     }
 }
@@ -146,6 +158,15 @@ pub struct Body {
     pub(crate) rolling_resistance: Real,
     pub(crate) torsional_friction: Real,
     pub(crate) bullet: bool,
+    /// Linear and angular damping (1/s; see [`BodyDef::linear_damping`]).
+    pub(crate) linear_damping: Real,
+    pub(crate) angular_damping: Real,
+    /// Multiplier of the world's gravity (see [`BodyDef::gravity_scale`]).
+    pub(crate) gravity_scale: Real,
+    /// A kinematic body's pose to reach at the end of the next step (centre of mass,
+    /// orientation), resolved into velocities when that step begins (see
+    /// `World::set_kinematic_target`).
+    pub(crate) kinematic_target: Option<(Vec3, Quat)>,
     /// Half the body's thinnest extent: moving farther in a step makes it a CCD candidate.
     pub(crate) ccd_extent: Real,
     /// How far any point of the shape lies from the centre of mass, at most (m): what a
@@ -211,6 +232,10 @@ impl Body {
             rolling_resistance: def.rolling_resistance,
             torsional_friction: def.torsional_friction,
             bullet: def.bullet,
+            linear_damping: def.linear_damping,
+            angular_damping: def.angular_damping,
+            gravity_scale: def.gravity_scale,
+            kinematic_target: None,
             ccd_extent: 0.0,
             ccd_reach: 0.0,
             awake: true,
@@ -280,6 +305,24 @@ impl Body {
     /// Torsional friction (m; see [`BodyDef::torsional_friction`]).
     pub fn torsional_friction(&self) -> Real {
         self.torsional_friction
+    }
+    /// Linear damping (1/s; see [`BodyDef::linear_damping`]).
+    pub fn linear_damping(&self) -> Real {
+        self.linear_damping
+    }
+    /// Angular damping (1/s; see [`BodyDef::angular_damping`]).
+    pub fn angular_damping(&self) -> Real {
+        self.angular_damping
+    }
+    /// Multiplier of the world's gravity (see [`BodyDef::gravity_scale`]).
+    pub fn gravity_scale(&self) -> Real {
+        self.gravity_scale
+    }
+    /// The pose (frame origin, orientation) a kinematic body was told to reach at the end
+    /// of the next step, until that step takes it (see `World::set_kinematic_target`).
+    pub fn kinematic_target(&self) -> Option<(Vec3, Quat)> {
+        self.kinematic_target
+            .map(|(com, q)| (com - q * self.local_center, q))
     }
     /// Collision layers (group) and the layers it collides with (mask).
     pub fn collision_filter(&self) -> (u32, u32) {
@@ -355,6 +398,22 @@ impl Body {
             + 0.5 * self.angular_velocity.dot(self.angular_momentum)
     }
 
+    /// The factors by which damping scales v and L (and ω) over `tau` seconds, the exact
+    /// solution of dv/dt = −c v: (exp(−c_v τ), exp(−c_ω τ)); `None` for a body without
+    /// damping or not dynamic, so that undamped bodies are stepped exactly as before.
+    #[inline]
+    pub(crate) fn damping_factors(&self, tau: Real) -> Option<(Real, Real)> {
+        if self.kind != BodyKind::Dynamic
+            || (self.linear_damping == 0.0 && self.angular_damping == 0.0)
+        {
+            return None;
+        }
+        Some((
+            (-self.linear_damping * tau).exp(),
+            (-self.angular_damping * tau).exp(),
+        ))
+    }
+
     /// ω from L for this body at orientation `q`: ω = R I⁻¹ Rᵀ L, or for a planar body
     /// the seed's 2D rule ω_z = L_z / I_zz.
     #[inline]
@@ -404,15 +463,14 @@ fn validate_def(def: &BodyDef) -> Result<()> {
     if let Some(c) = def.center_of_mass {
         check::vec3_at_most("center_of_mass", c, MAX_COORDINATE, "m")?;
     }
-    check::non_negative("friction", def.friction)?;
-    check::at_most("friction", def.friction, crate::limits::MAX_MAGNITUDE, "")?;
-    check::non_negative("restitution", def.restitution)?;
-    if def.restitution > 1.0 {
-        return Err(Error::invalid("restitution", "must be <= 1"));
-    }
+    check_friction(def.friction)?;
+    check_restitution(def.restitution)?;
+    check_gravity_scale(def.gravity_scale)?;
     for (field, x) in [
         ("rolling_resistance", def.rolling_resistance),
         ("torsional_friction", def.torsional_friction),
+        ("linear_damping", def.linear_damping),
+        ("angular_damping", def.angular_damping),
     ] {
         // Finite, within the magnitude limit, and not negative.
         check::non_negative(field, x)?;
@@ -421,6 +479,26 @@ fn validate_def(def: &BodyDef) -> Result<()> {
         MassSpec::Density(d) => check::positive("density", d),
         MassSpec::Mass(m) => check::positive("mass", m),
     }
+}
+
+/// The rule for `friction`, at creation and in `World::set_friction`.
+pub(crate) fn check_friction(x: Real) -> Result<()> {
+    check::non_negative("friction", x)?;
+    check::at_most("friction", x, crate::limits::MAX_MAGNITUDE, "")
+}
+
+/// The rule for `restitution`: in [0, 1].
+pub(crate) fn check_restitution(x: Real) -> Result<()> {
+    check::non_negative("restitution", x)?;
+    if x > 1.0 {
+        return Err(Error::invalid("restitution", "must be <= 1"));
+    }
+    Ok(())
+}
+
+/// The rule for `gravity_scale`: finite, at most `MAX_GRAVITY_SCALE` either way.
+pub(crate) fn check_gravity_scale(x: Real) -> Result<()> {
+    check::at_most("gravity_scale", x, crate::limits::MAX_GRAVITY_SCALE, "")
 }
 
 /// Planes are stored with a unit normal so every routine can rely on it.

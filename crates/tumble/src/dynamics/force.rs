@@ -260,7 +260,7 @@ impl SpringGeometry {
     }
 }
 
-/// Adds gravity and every force element, evaluated at `motions`, into `out`.
+/// Adds gravity (times each body's `gravity_scale`) and every force element, evaluated at `motions`, into `out`.
 pub(crate) fn accumulate(
     gravity: Vec3,
     forces: &[Force],
@@ -272,7 +272,7 @@ pub(crate) fn accumulate(
     for ((w, body), _m) in out.iter_mut().zip(bodies).zip(motions) {
         *w = Wrench {
             force: if body.kind == BodyKind::Dynamic {
-                gravity * body.mass
+                gravity * (body.mass * body.gravity_scale)
             } else {
                 Vec3::ZERO
             },

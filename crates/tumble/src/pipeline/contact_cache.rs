@@ -106,8 +106,8 @@ impl PairWorld<'_> {
     /// narrow phase).
     ///
     /// Only relative motion counts: bodies falling side by side (the rain) close nothing,
-    /// and gravity changes their relative velocity only if one of them does not fall
-    /// (summing each body's own speed made the rain's narrow phase see pairs 30 cm apart,
+    /// and gravity changes their relative velocity only by the difference of their
+    /// gravity scales, 1 when one of them does not fall (summing each body's own speed made the rain's narrow phase see pairs 30 cm apart,
     /// +11 % instructions). And each body's share stops at its CCD extent: a body moving
     /// farther is swept against static geometry by `pipeline/ccd.rs`, and a margin of its
     /// whole travel (8 m for a 500 m/s shot) found speculative points on every triangle
@@ -117,7 +117,7 @@ impl PairWorld<'_> {
             return self.margin;
         }
         let (dt, kick) = self.step;
-        let fall = if a.falls != b.falls { kick } else { 0.0 };
+        let fall = kick * (a.fall - b.fall).abs();
         let closing = ((b.velocity - a.velocity).length() + fall) * dt + a.turn + b.turn;
         self.margin.max(closing.min(a.cap + b.cap))
     }
@@ -138,7 +138,11 @@ impl PairWorld<'_> {
             } else {
                 0.0
             },
-            falls: moving && body.kind == BodyKind::Dynamic,
+            fall: if moving && body.kind == BodyKind::Dynamic {
+                body.gravity_scale
+            } else {
+                0.0
+            },
             cap: if moving { body.ccd_extent } else { 0.0 },
             bounces,
         }
@@ -156,8 +160,8 @@ struct Motion {
     velocity: Vec3,
     /// How far its spin can carry a point over the step (m); zero unless it bounces.
     turn: Real,
-    /// Whether gravity moves it.
-    falls: bool,
+    /// The share of gravity that moves it: its `gravity_scale`, 0 if it does not move.
+    fall: Real,
     /// Its CCD extent (m), zero if it does not move.
     cap: Real,
     /// Whether it has a restitution above zero.
@@ -245,7 +249,7 @@ impl Motions {
             pose: Pose::IDENTITY,
             velocity: Vec3::ZERO,
             turn: 0.0,
-            falls: false,
+            fall: 0.0,
             cap: 0.0,
             bounces: false,
         };
@@ -677,7 +681,8 @@ impl ContactCache {
 /// meet the next box's side face (its separating axis wins while the gap is open) and catch.
 /// The test: step `nudge` from the point on the static surface along its outward normal;
 /// landing inside (or within a tenth of `nudge` of) another static body means the face is
-/// covered there.
+/// covered there. Static bodies the moving body does not collide with (its filter) cover
+/// nothing.
 fn drop_covered_points(
     m: &mut Manifold,
     (a, b): (usize, usize),
@@ -694,6 +699,9 @@ fn drop_covered_points(
     }
     // Outward from the static body: +n if it is A (the normal points from A to B).
     let (fixed, out) = if sa { (a, m.normal) } else { (b, -m.normal) };
+    // Only a body the moving one collides with covers a face: a floor under a ground
+    // whose layer the body's mask leaves out must still hold it.
+    let filter = bodies[if sa { b } else { a }].filter;
     let mut covered = |surface: Vec3| {
         let probe = surface + out * nudge;
         let mut inside = false;
@@ -701,7 +709,8 @@ fn drop_covered_points(
         broad.query_static_aabb_with(&Aabb::new(probe, probe), stack, |user| {
             let k = user as usize;
             if !inside && k != fixed {
-                if let Some(other) = bodies.get(k).filter(|o| o.kind == BodyKind::Static) {
+                let covers = |o: &&Body| o.kind == BodyKind::Static && o.filter.allows(&filter);
+                if let Some(other) = bodies.get(k).filter(covers) {
                     // Within a tenth of the step of the other body counts: the normal can be
                     // tilted by a hair and lift the probe off a face level with this one.
                     inside =

@@ -32,7 +32,7 @@ pub(crate) fn measure(
     for body in bodies.iter().filter(|b| b.kind == BodyKind::Dynamic) {
         let p = body.linear_momentum();
         d.kinetic += body.kinetic_energy();
-        d.potential -= body.mass * gravity.dot(body.com);
+        d.potential -= body.mass * body.gravity_scale * gravity.dot(body.com);
         d.linear_momentum += p;
         d.angular_momentum += body.com.cross(p) + body.angular_momentum;
     }

@@ -102,7 +102,7 @@ fn meet_by_the_end(a: &Shape, sa: &Sweep, b: &Shape, sb: &Sweep, near: Real) -> 
     }
 }
 
-/// The velocity gravity adds to a body over the step.
+/// The velocity gravity (times the body's `gravity_scale`) adds to a body over the step.
 fn kick(body: &Body, gravity: Vec3, dt: Real) -> Vec3 {
     if body.kind == BodyKind::Dynamic && body.awake {
         let g = if body.planar {
@@ -110,7 +110,7 @@ fn kick(body: &Body, gravity: Vec3, dt: Real) -> Vec3 {
         } else {
             gravity
         };
-        g * dt
+        g * (body.gravity_scale * dt)
     } else {
         Vec3::ZERO
     }

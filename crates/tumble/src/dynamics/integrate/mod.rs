@@ -250,6 +250,7 @@ pub(crate) fn advance(
     scratch: &mut Scratch,
     discarded: &[bool],
 ) {
+    damp_half(sys.bodies, motions, Some(memory), dt);
     scratch.start.clear();
     scratch.start.extend_from_slice(motions);
     scratch.resize(motions.len());
@@ -264,6 +265,7 @@ pub(crate) fn advance(
         Integrator::Verlet => symplectic::verlet(sys, motions, &mut memory.verlet, t, dt, scratch),
         Integrator::ImplicitEuler => implicit_euler::step(sys, motions, t, dt, scratch),
     }
+    damp_half(sys.bodies, motions, None, dt);
     // Prescribed motion is known exactly; no method should add its own error to it.
     for ((m, start), body) in motions.iter_mut().zip(&scratch.start).zip(sys.bodies) {
         if body.kind != BodyKind::Dynamic {
@@ -271,6 +273,40 @@ pub(crate) fn advance(
         }
     }
     move_kinematic(sys.bodies, motions, dt);
+}
+
+/// Half a step of damping, dv/dt = −c v and dL/dt = −c L solved exactly: v, L and ω
+/// (linear in L at the fixed orientation) scaled by exp(−c dt/2). `advance` puts one half
+/// before the integrator's step and one after (Strang splitting), so that
+/// - the decay itself is exact for every method: a free body's v is v₀ exp(−c t) to
+///   rounding, where damping as a force would give explicit Euler (1 − c dt)ⁿ, 13 % off
+///   at c = 5 /s, dt = 1/60 s after three time constants;
+/// - the coupling with the other forces is second order and symmetric: under gravity the
+///   terminal speed comes out at (g/c)·(c dt/2)/sinh(c dt/2), within (c dt)²/24 of g/c
+///   (0.03 % at c = 5 /s, dt = 1/60 s), where one whole factor after the step would be
+///   off by c dt/2 (4 %).
+///
+/// Störmer–Verlet's memory holds the undamped motion (its velocity is x − x₋), so a
+/// damped body's memory is forgotten before each step: the method restarts from the
+/// damped velocity (`verlet`'s Taylor start), which for forces that vary slowly over a
+/// step is its own result to O(dt³).
+fn damp_half(
+    bodies: &[Body],
+    motions: &mut [Motion],
+    mut memory: Option<&mut IntegratorMemory>,
+    dt: Real,
+) {
+    for (i, (m, body)) in motions.iter_mut().zip(bodies).enumerate() {
+        let Some((fv, fw)) = body.damping_factors(0.5 * dt) else {
+            continue;
+        };
+        m.v *= fv;
+        m.l *= fw;
+        m.w *= fw;
+        if let Some(memory) = memory.as_deref_mut() {
+            memory.forget(i);
+        }
+    }
 }
 
 /// Moves kinematic bodies exactly along their prescribed velocities: x + dt v,

@@ -172,6 +172,8 @@ pub(crate) struct BodySim {
     /// Rolling resistance (dimensionless) and torsional friction (m); see `BodyDef`.
     pub rolling_resistance: Real,
     pub torsional_friction: Real,
+    /// The body's multiplier of gravity (see `BodyDef::gravity_scale`).
+    pub gravity_scale: Real,
     /// The shape's `Shape::round_radius`, or `None` for a compound, whose children differ:
     /// read here, the step's contacts need not reach into the bodies' shapes.
     pub round: Option<Real>,
@@ -217,6 +219,7 @@ impl BodySim {
             local_center: body.local_center,
             rolling_resistance: body.rolling_resistance,
             torsional_friction: body.torsional_friction,
+            gravity_scale: body.gravity_scale,
             round: match body.shape {
                 crate::collision::shape::Shape::Compound(_) => None,
                 ref shape => Some(shape.round_radius(0)),

@@ -15,7 +15,7 @@
 //! `scatter`, after the check, so they need nothing; the contact cache built its new
 //! contacts beside last step's and swaps back; what remains (the sleep state
 //! `wake_touched` changes, the joints' warm starts and broken flags, the integrator's
-//! memory) is copied before the stages run, about 30 bytes per body and the joint list.
+//! memory, the kinematic targets taken) is copied before the stages run, about 30 bytes per body and the joint list.
 //! Force callbacks are the user's code and are not undone.
 
 use crate::dynamics::body::{Body, BodyKind};
@@ -24,7 +24,7 @@ use crate::dynamics::joint::Joint;
 use crate::dynamics::solver::{SolverBodies, StepTime};
 use crate::error::{Error, Result, TooManyContacts, Unstable};
 use crate::limits::{short, SpeedLimits, MAX_COORDINATE};
-use crate::math::{vec3_is_finite, Real, Vec3};
+use crate::math::{vec3_is_finite, Quat, Real, Vec3};
 use crate::pipeline::world::World;
 
 /// What a step changes before its check, as it was before the step.
@@ -34,6 +34,9 @@ pub(crate) struct Undo {
     sleep: Vec<(bool, Real)>,
     joints: Vec<Joint>,
     memory: IntegratorMemory,
+    /// The kinematic targets the step took: body, target, velocity and angular velocity
+    /// before (see `take_kinematic_targets`).
+    pub(super) targets: Vec<(usize, (Vec3, Quat), Vec3, Vec3)>,
 }
 
 impl World {
@@ -45,6 +48,7 @@ impl World {
             .extend(self.bodies.list.iter().map(|b| (b.awake, b.sleep_time)));
         undo.joints.clone_from(&self.joints.list);
         undo.memory.clone_from(&self.memory);
+        undo.targets.clear();
     }
 
     /// Checks the step's result; on failure undoes the step and says where and when.
@@ -90,6 +94,10 @@ impl World {
         }
         std::mem::swap(&mut self.joints.list, &mut undo.joints);
         std::mem::swap(&mut self.memory, &mut undo.memory);
+        for &(i, target, v, w) in &undo.targets {
+            let b = &mut self.bodies.list[i];
+            (b.kinematic_target, b.velocity, b.angular_velocity) = (Some(target), v, w);
+        }
         self.collision.contacts.undo_update();
     }
 }

@@ -26,6 +26,7 @@ mod invariant;
 mod joint_coords;
 mod joint_edit;
 mod joints;
+mod properties;
 pub mod query;
 pub(crate) mod step;
 

@@ -4,6 +4,8 @@
 //! ```text
 //! stage                reads                               writes
 //! refresh_joint_links  joints, body handles                joints' dense bodies, joined pairs
+//! take_kinematic_targets  kinematic targets, bodies        kinematic bodies' velocities,
+//!                                                          awake flags; targets cleared
 //! update_contacts      bodies, broad phase, joined pairs   broad-phase pairs, contact cache
 //! check_contacts       contact cache                       nothing; past the step's contact
 //!                                                          limit, undoes the step and
@@ -100,6 +102,7 @@ impl World {
         let time = StepTime::new(self.clock.time, dt, &self.settings.solver);
         self.refresh_joint_links();
         self.keep_undo();
+        self.take_kinematic_targets(dt);
         self.update_contacts_for(dt);
         self.check_contacts(&time)?;
         self.wake_touched();

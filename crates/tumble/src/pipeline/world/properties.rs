@@ -1,0 +1,124 @@
+//! Run-time edits of a body's properties: friction, restitution, collision filter,
+//! damping, gravity scale, and a kinematic body's target pose. Each checks its value with
+//! the rule `World::create_body` applies to the same field of `BodyDef` (the same message,
+//! so a scene file, Rust and Python refuse a value alike), changes nothing when it fails,
+//! and wakes the body and what touches it: a resting pile must notice that its friction
+//! went, or its support stopped colliding.
+
+use crate::collision::broad_phase::Filter;
+use crate::dynamics::body::BodyKind;
+use crate::dynamics::body::{check_friction, check_gravity_scale, check_restitution, Body};
+use crate::error::{check, Error, Result};
+use crate::id::BodyId;
+use crate::limits::MAX_COORDINATE;
+use crate::math::{rotation_vector, Quat, Real, Vec3};
+use crate::pipeline::world::World;
+
+impl World {
+    /// Changes one property of body `id` through `edit` (its value already checked), then
+    /// wakes it and the islands touching it.
+    fn edit_property(&mut self, id: BodyId, edit: impl FnOnce(&mut Body)) -> Result<()> {
+        let i = self.dense(id).ok_or(Error::UnknownBody {
+            field: "body".into(),
+            id,
+        })?;
+        edit(&mut self.bodies.list[i]);
+        self.wake_around(i);
+        Ok(())
+    }
+
+    /// Sets a body's Coulomb friction coefficient (>= 0; a pair uses √(μ_a μ_b)), from the
+    /// next step on.
+    pub fn set_friction(&mut self, id: BodyId, friction: Real) -> Result<()> {
+        check_friction(friction)?;
+        self.edit_property(id, |b| b.friction = friction)
+    }
+
+    /// Sets a body's coefficient of restitution (in [0, 1]; a pair uses the larger).
+    pub fn set_restitution(&mut self, id: BodyId, restitution: Real) -> Result<()> {
+        check_restitution(restitution)?;
+        self.edit_property(id, |b| b.restitution = restitution)
+    }
+
+    /// Sets a body's collision layers (`group`) and the layers it collides with (`mask`).
+    /// The broad phase searches the body's pairs again at the next step: a pair the new
+    /// filter forbids stops colliding there, one it allows starts.
+    pub fn set_collision_filter(&mut self, id: BodyId, group: u32, mask: u32) -> Result<()> {
+        let filter = Filter { group, mask };
+        self.edit_property(id, |b| b.filter = filter)?;
+        // `edit_property` found the body, so its dense index exists.
+        if let Some(i) = self.dense(id) {
+            let c = &mut self.collision;
+            c.broad_phase.set_filter(c.proxies[i], filter);
+        }
+        Ok(())
+    }
+
+    /// Sets a body's linear damping (1/s, >= 0): dv/dt = −c v besides the forces.
+    pub fn set_linear_damping(&mut self, id: BodyId, damping: Real) -> Result<()> {
+        check::non_negative("linear_damping", damping)?;
+        self.edit_property(id, |b| b.linear_damping = damping)
+    }
+
+    /// Sets a body's angular damping (1/s, >= 0): dL/dt = −c L besides the torques.
+    pub fn set_angular_damping(&mut self, id: BodyId, damping: Real) -> Result<()> {
+        check::non_negative("angular_damping", damping)?;
+        self.edit_property(id, |b| b.angular_damping = damping)
+    }
+
+    /// Sets the multiplier of the world's gravity for a body (|s| <= 1e6).
+    pub fn set_gravity_scale(&mut self, id: BodyId, scale: Real) -> Result<()> {
+        check_gravity_scale(scale)?;
+        self.edit_property(id, |b| b.gravity_scale = scale)
+    }
+
+    /// Tells a kinematic body to be at `position` (its frame's origin, m) and
+    /// `orientation` exactly at the end of the next step. The target is kept until that
+    /// step, which sets the body's velocities from its `dt`: v = Δx / dt and ω = θ / dt,
+    /// θ the rotation vector of q_target q⁻¹ taken the short way (at most π). The body then
+    /// keeps those velocities, as any kinematic body keeps the velocity it is given: give
+    /// a target every step to drive it along a path, or its own pose (or zero velocities)
+    /// to stop it. What it pushes or carries meets it moving at those velocities through
+    /// the step. Refused (nothing changed) for a body that is not kinematic.
+    pub fn set_kinematic_target(
+        &mut self,
+        id: BodyId,
+        position: Vec3,
+        orientation: Quat,
+    ) -> Result<()> {
+        check::vec3_at_most("position", position, MAX_COORDINATE, "m")?;
+        let q = check::rotation("orientation", orientation)?;
+        let kind = self.body(id)?.kind;
+        if kind != BodyKind::Kinematic {
+            return Err(Error::invalid(
+                "kind",
+                "a kinematic target needs a kinematic body",
+            ));
+        }
+        self.edit_property(id, |b| {
+            b.kinematic_target = Some((position + q * b.local_center, q));
+        })
+    }
+
+    /// Stage of the step, before the contact update (whose margins and ghost checks read
+    /// the velocities): every kinematic body with a target gets the velocities that take
+    /// it there over `dt` (the way `move_kinematic` moves it: x₀ + dt v, exp(dt ω/2) q₀),
+    /// wakes, and forgets the target; the step's undo keeps what it took.
+    pub(super) fn take_kinematic_targets(&mut self, dt: Real) {
+        for (i, b) in self.bodies.list.iter_mut().enumerate() {
+            let Some((com, q)) = b.kinematic_target.take() else {
+                continue;
+            };
+            let undo = (i, (com, q), b.velocity, b.angular_velocity);
+            self.scratch.undo.targets.push(undo);
+            b.velocity = (com - b.com) / dt;
+            b.angular_velocity = rotation_vector(q * b.orientation.inverse()) / dt;
+            if b.planar {
+                // As `set_linear_velocity` and `set_angular_velocity` do for a planar body.
+                b.velocity.z = 0.0;
+                b.angular_velocity = Vec3::new(0.0, 0.0, b.angular_velocity.z);
+            }
+            (b.awake, b.sleep_time) = (true, 0.0);
+        }
+    }
+}
