@@ -28,9 +28,12 @@ fn tumble_is_f32() -> bool {
     std::mem::size_of::<tumble::Real>() == 4
 }
 
+/// Builds a scene in one engine.
+type Builder = fn(&SceneSpec) -> Box<dyn Simulation>;
+
 /// Each engine, by name, with a builder for a scene.
-fn engines() -> [(&'static str, fn(&SceneSpec) -> Box<dyn Simulation>); 2] {
-    let rapier: fn(&SceneSpec) -> Box<dyn Simulation> = if tumble_is_f32() {
+fn engines() -> [(&'static str, Builder); 2] {
+    let rapier: Builder = if tumble_is_f32() {
         |s| Box::new(rapier_f32::build(s))
     } else {
         |s| Box::new(rapier_f64::build(s))

@@ -21,8 +21,8 @@ pub const JOINT_GRID_TIMED_STEPS: usize = 300;
 /// Whether the body at column `c` (along x) of the first row (z = 0) is fixed: every
 /// fourth one and the last, rapier's `joint_ball3` pattern (`i == 0 && (k % 4 == 0 ||
 /// k == num - 1)`); every other body is dynamic.
-fn is_fixed(column: usize, row: usize) -> bool {
-    row == 0 && (column.is_multiple_of(4) || column == JOINT_GRID_SIZE - 1)
+fn is_fixed(column: usize, row: usize, n: usize) -> bool {
+    row == 0 && (column.is_multiple_of(4) || column == n - 1)
 }
 
 /// 30 × 30 balls (radius 0.4 m) 1 m apart on the plane y = 0, body `row * 30 + column` at
@@ -34,14 +34,29 @@ fn is_fixed(column: usize, row: usize) -> bool {
 /// one between the two fixed bodies at columns 28 and 29, which could never move: 1,739
 /// joints. There is no ground.
 pub fn joint_grid() -> SceneSpec {
-    let n = JOINT_GRID_SIZE;
+    joint_grid_of("joints", JOINT_GRID_SIZE)
+}
+
+/// Bodies along each side of [`joint_grid_large`]: Box2D's and Box3D's joint grid size.
+pub const JOINT_GRID_LARGE_SIZE: usize = 100;
+
+/// [`joint_grid`] at Box3D's size: 100 × 100 balls, 26 fixed (columns 0, 4, …, 96 and
+/// 99 of the first row), 2 · 100 · 99 = 19,800 joints (no two fixed bodies are
+/// neighbours). Box3D's own grid hangs in the vertical plane from its whole top row; this
+/// is the existing net, generalised, so the two sizes compare.
+pub fn joint_grid_large() -> SceneSpec {
+    joint_grid_of("joint_grid_large", JOINT_GRID_LARGE_SIZE)
+}
+
+/// The joint grid with `n` × `n` balls (n ≥ 2), named `name`; [`joint_grid`] is n = 30.
+pub fn joint_grid_of(name: &'static str, n: usize) -> SceneSpec {
     let s = JOINT_GRID_SPACING;
     let first = -0.5 * (n as f64 - 1.0) * s;
     let mut bodies = Vec::with_capacity(n * n);
     for row in 0..n {
         for column in 0..n {
             bodies.push(BodySpec {
-                dynamic: !is_fixed(column, row),
+                dynamic: !is_fixed(column, row, n),
                 shape: ShapeSpec::Sphere(JOINT_GRID_RADIUS),
                 position: [first + column as f64 * s, 0.0, row as f64 * s],
                 rotation: [0.0; 3],
@@ -71,7 +86,7 @@ pub fn joint_grid() -> SceneSpec {
         }
     }
     SceneSpec {
-        name: "joints",
+        name,
         bodies,
         joints,
     }

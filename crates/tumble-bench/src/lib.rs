@@ -16,7 +16,7 @@
 //! | density     | 1000 kg/m³                               | 1000 kg/m³                             |
 //! | gravity     | (0, −9.81, 0) m/s²                       | (0, −9.81, 0) m/s²                     |
 //! | sleeping    | `WorldDef { sleep: false }`              | `RigidBodyBuilder::can_sleep(false)`   |
-//! | threads     | one                                      | one (no `parallel` feature)            |
+//! | threads     | one (`--threads N` in `compare`: N)      | the same count: rapier's `parallel` feature, each world's step run in a rayon pool of that many threads ([`rayon_pool`]) |
 //! | ball joints | `JointKind::Ball` without limits, `collide_connected: false` (default) | `SphericalJointBuilder` as an impulse joint, `contacts_enabled(false)` (rapier's default is true) |
 //!
 //! Everything else is each engine's default (rapier: contact recycling and clustering on,
@@ -30,13 +30,30 @@
 //! | `pyramid` | 385 unit boxes in a 10×10-base pyramid on the ground    | [`pyramid`]       |
 //! | `rain`    | 2,000 spheres and boxes dropped into a walled container | [`rain`]          |
 //! | `joints`  | 30 × 30 balls joined by 1,739 ball joints into a net hanging from one edge | [`joint_grid()`] |
+//!
+//! and, at Box3D's published sizes ([`scale`]; `compare --scale`):
+//!
+//! | scene              | what                                                    | built by               |
+//! |--------------------|---------------------------------------------------------|------------------------|
+//! | `large_pyramid`    | 5,050 unit cubes, a 100-base pyramid one cube thick     | [`large_pyramid`]      |
+//! | `many_pyramids`    | 14 × 14 pyramids of base 10, 10,780 cubes               | [`many_pyramids`]      |
+//! | `joint_grid_large` | the joint grid at 100 × 100: 10,000 balls, 19,800 joints | [`joint_grid_large()`] |
+//! | `rain_large`       | the rain at 10,000 bodies in a 25 m × 25 m container     | [`rain_large`]         |
 
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 pub mod joint_grid;
+pub mod scale;
+pub mod scenes;
 pub use joint_grid::{
-    joint_grid, measure_joint_grid, JointGridResult, JOINT_GRID_SETTLE_STEPS,
-    JOINT_GRID_TIMED_STEPS,
+    joint_grid, joint_grid_large, joint_grid_of, measure_joint_grid, JointGridResult,
+    JOINT_GRID_LARGE_SIZE, JOINT_GRID_SETTLE_STEPS, JOINT_GRID_TIMED_STEPS,
+};
+pub use scale::{
+    large_pyramid, many_pyramids, rain_large, RAIN_LARGE_HALF_WIDTH, RAIN_LARGE_TIMED_STEPS,
+    SCALE_JOINT_GRID_SETTLE_STEPS, SCALE_JOINT_GRID_TIMED_STEPS, SCALE_PYRAMID_SETTLE_STEPS,
+    SCALE_PYRAMID_TIMED_STEPS,
 };
 
 /// Time step of every scene (s).
@@ -87,7 +104,7 @@ pub struct BallJointSpec {
 /// A scene: its bodies, static ones included, in creation order, and its joints.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneSpec {
-    /// Short name (`pyramid`, `rain`, `joints`).
+    /// Short name (`pyramid`, `rain`, `joints`, or a [`scale`] scene's).
     pub name: &'static str,
     /// Every body, static ones included.
     pub bodies: Vec<BodySpec>,
@@ -165,9 +182,19 @@ fn splitmix(state: &mut u64) -> f64 {
 /// rotation. A box's half diagonal is 0.433 m, so no two bodies start overlapping
 /// (0.866 < 0.9 m) and every body starts inside the walls (4.5 + 0.05 + 0.433 < 5).
 pub fn rain() -> SceneSpec {
-    let (h, t, wall) = (RAIN_HALF_WIDTH, 0.25, RAIN_WALL_HEIGHT);
+    rain_grid("rain", 10, 20)
+}
+
+/// The rain with `columns` × `columns` bodies per layer and `layers` layers: the grid is
+/// 1 m across, so the container's inside is `columns` m wide (half width `columns / 2`),
+/// the floor box reaches 15 m past the walls on every side, and the jitter comes from the
+/// same generator and seed, drawn in the same order (layer, then x, then z), so
+/// `rain_grid("rain", 10, 20)` is exactly [`rain`].
+pub fn rain_grid(name: &'static str, columns: usize, layers: usize) -> SceneSpec {
+    let (h, t, wall) = (0.5 * columns as f64, 0.25, RAIN_WALL_HEIGHT);
+    let floor = h + 15.0;
     let mut bodies = vec![
-        fixed(ShapeSpec::Cuboid([20.0, 0.5, 20.0]), [0.0, -0.5, 0.0]),
+        fixed(ShapeSpec::Cuboid([floor, 0.5, floor]), [0.0, -0.5, 0.0]),
         fixed(
             ShapeSpec::Cuboid([t, wall / 2.0, h + 2.0 * t]),
             [-h - t, wall / 2.0, 0.0],
@@ -187,18 +214,19 @@ pub fn rain() -> SceneSpec {
     ];
     let mut rng = 0x5EED_u64;
     let mut jitter = |scale: f64| scale * (2.0 * splitmix(&mut rng) - 1.0);
-    for k in 0..20 {
-        for i in 0..10 {
-            for j in 0..10 {
+    let first = -0.5 * (columns as f64 - 1.0);
+    for k in 0..layers {
+        for i in 0..columns {
+            for j in 0..columns {
                 let shape = if (i + j + k) % 2 == 0 {
                     ShapeSpec::Sphere(0.25)
                 } else {
                     ShapeSpec::Cuboid([0.25; 3])
                 };
                 let position = [
-                    i as f64 - 4.5 + jitter(0.05),
+                    first + i as f64 + jitter(0.05),
                     4.0 + 0.9 * k as f64,
-                    j as f64 - 4.5 + jitter(0.05),
+                    first + j as f64 + jitter(0.05),
                 ];
                 let axis = [jitter(1.0), jitter(1.0), jitter(1.0)];
                 let norm = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
@@ -214,7 +242,7 @@ pub fn rain() -> SceneSpec {
         }
     }
     SceneSpec {
-        name: "rain",
+        name,
         bodies,
         joints: Vec::new(),
     }
@@ -233,6 +261,30 @@ pub trait Simulation {
     /// For each joint, in scene order, the distance between its two anchors in world
     /// coordinates (m): zero for a joint that holds.
     fn joint_gaps(&self) -> Vec<f64>;
+    /// How many threads a step runs on, as the engine reports it from where its step runs
+    /// (Tumble: `World::threads`; rapier: `rayon::current_num_threads()` inside its pool).
+    fn threads(&self) -> usize;
+}
+
+/// The shared rayon pool of `threads` threads (at least one) that rapier's steps run in,
+/// made on first use: every rapier world of a run with the same count shares it, as
+/// Tumble's worlds share theirs.
+pub fn rayon_pool(threads: usize) -> Arc<rayon::ThreadPool> {
+    static POOLS: Mutex<Vec<(usize, Arc<rayon::ThreadPool>)>> = Mutex::new(Vec::new());
+    let threads = threads.max(1);
+    let mut pools = POOLS.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, pool)) = pools.iter().find(|(n, _)| *n == threads) {
+        return pool.clone();
+    }
+    let pool = Arc::new(
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .thread_name(|i| format!("bench-rapier-{i}"))
+            .build()
+            .expect("a rayon thread pool"),
+    );
+    pools.push((threads, pool.clone()));
+    pool
 }
 
 /// Distance between two points (m).
@@ -325,8 +377,19 @@ pub mod tumble_engine {
         [wide(p.x), wide(p.y), wide(p.z)]
     }
 
-    /// Builds `spec`: 4 substeps of 1 iteration, sleeping off, gravity −9.81 m/s².
+    /// Builds `spec` on one thread, or on as many as `TUMBLE_THREADS` asks for.
     pub fn build(spec: &SceneSpec) -> TumbleScene {
+        let threads = tumble::threads::threads_from_env()
+            .ok()
+            .flatten()
+            .unwrap_or(1);
+        build_with_threads(spec, threads)
+    }
+
+    /// Builds `spec`: 4 substeps of 1 iteration, sleeping off, gravity −9.81 m/s², steps
+    /// on `threads` threads (clamped to Tumble's 1 to `MAX_THREADS`).
+    pub fn build_with_threads(spec: &SceneSpec, threads: usize) -> TumbleScene {
+        let threads = threads.clamp(1, tumble::threads::MAX_THREADS);
         let mut world = World::try_new(&WorldDef {
             gravity: Vec3::new(0.0, super::GRAVITY_Y as Real, 0.0),
             solver: SolverSettings {
@@ -335,13 +398,7 @@ pub mod tumble_engine {
                 ..Default::default()
             },
             sleep: false,
-            // One thread, as the tables say, unless TUMBLE_THREADS asks for more.
-            threads: Some(
-                tumble::threads::threads_from_env()
-                    .ok()
-                    .flatten()
-                    .unwrap_or(1),
-            ),
+            threads: Some(threads),
             ..Default::default()
         })
         .expect("valid world settings");
@@ -404,6 +461,9 @@ pub mod tumble_engine {
                     )
                 })
                 .collect()
+        }
+        fn threads(&self) -> usize {
+            self.world.threads()
         }
     }
 }
@@ -485,9 +545,18 @@ macro_rules! rapier_engine {
                 }
             }
 
-            /// Builds `spec` with [`integration_parameters`], sleeping off, gravity −9.81 m/s².
+            /// Builds `spec` on one thread (a rayon pool of one: with the `parallel`
+            /// feature a world without a pool would use rayon's global pool, every core).
             pub fn build(spec: &SceneSpec) -> RapierScene {
+                build_with_threads(spec, 1)
+            }
+
+            /// Builds `spec` with [`integration_parameters`], sleeping off, gravity −9.81 m/s²;
+            /// every step runs inside the shared pool of `threads` threads
+            /// ([`crate::rayon_pool`]; rapier's step is `pool.install(...)`).
+            pub fn build_with_threads(spec: &SceneSpec, threads: usize) -> RapierScene {
                 let mut world = PhysicsWorld::new();
+                world.set_thread_pool(Some(super::rayon_pool(threads)));
                 world.gravity = Vector::new(0.0, super::GRAVITY_Y as Real, 0.0);
                 world.integration_parameters = integration_parameters();
                 let mut bodies = Vec::with_capacity(spec.bodies.len());
@@ -549,6 +618,13 @@ macro_rules! rapier_engine {
                             )
                         })
                         .collect()
+                }
+                fn threads(&self) -> usize {
+                    // Asked from inside the pool the step runs in, as rapier's own
+                    // parallel loops ask.
+                    self.world
+                        .thread_pool()
+                        .map_or(0, |pool| pool.install(rayon::current_num_threads))
                 }
             }
         }
@@ -661,6 +737,12 @@ pub struct RainCount {
 
 /// Counts where the rain's bodies are.
 pub fn count_rain(positions: &[[f64; 3]]) -> RainCount {
+    count_rain_in(positions, RAIN_HALF_WIDTH)
+}
+
+/// Counts where a rain's bodies are, for a container of inner half width `half_width`
+/// (m): [`RAIN_HALF_WIDTH`] for [`rain`], [`RAIN_LARGE_HALF_WIDTH`] for [`rain_large`].
+pub fn count_rain_in(positions: &[[f64; 3]], half_width: f64) -> RainCount {
     let mut c = RainCount {
         inside: 0,
         outside: 0,
@@ -669,7 +751,7 @@ pub fn count_rain(positions: &[[f64; 3]]) -> RainCount {
     for p in positions {
         if !p.iter().all(|x| x.is_finite()) || p[1] < -0.25 {
             c.off_floor += 1;
-        } else if p[0].abs() < RAIN_HALF_WIDTH && p[2].abs() < RAIN_HALF_WIDTH {
+        } else if p[0].abs() < half_width && p[2].abs() < half_width {
             c.inside += 1;
         } else {
             c.outside += 1;
