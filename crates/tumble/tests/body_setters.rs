@@ -204,7 +204,9 @@ fn gravity_scale_scales_the_fall() {
             (b.linear_velocity().y, b.position().y - 10.0)
         };
         let (v1, d1) = state(0);
-        let eps = tol(1e-12, 1e-5);
+        // f32: Störmer–Verlet's velocity is (x₊ − x)/dt, rounded to ulp(10 m)/dt ≈ 1e-4
+        // m/s each step (measured 2e-4 relative after 100 steps); the others 1e-5.
+        let eps = tol(1e-12, 1e-3);
         for (k, s) in [(1, 0.5), (2, 0.0), (3, -1.0)] {
             let (v, d) = state(k);
             assert!(
