@@ -70,7 +70,10 @@ fn scenes_named(name: Option<&str>) -> Result<Vec<&'static str>, String> {
 fn count(flag: &str, text: Option<&String>) -> Result<usize, String> {
     text.and_then(|n| n.trim().parse().ok())
         .filter(|n| *n >= 1)
-        .ok_or_else(|| format!("{flag}: expected a whole number >= 1, got {text:?}"))
+        .ok_or_else(|| match text {
+            Some(t) => format!("{flag}: expected a whole number >= 1, got {t:?}"),
+            None => format!("{flag}: expected a whole number >= 1"),
+        })
 }
 
 fn parse(args: &[String]) -> Result<Options, String> {
