@@ -81,7 +81,7 @@ impl Softness {
 /// Uncapped, or at 8, a 1:1000 pair and a 200:1 slab on cubes slid apart at 1 to 4 m/s
 /// even with six passes. Stiffening every island's contacts at the default pass made a
 /// 20-box tower of equal boxes lean 5.5 cm at 1.5 times (9.6 mm unstiffened) and fall
-/// from 2 times (docs/integrators.md, "Towers of equal bodies still sag").
+/// from 2 times (docs/integrators.md, "Tall stacks": finer substeps are the cure).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct LoadSpring {
     /// hω(2ζ + hω) of the contacts' spring; zero for a rigid row (PGS).
