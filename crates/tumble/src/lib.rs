@@ -22,6 +22,7 @@ pub mod id;
 pub mod limits;
 pub mod math;
 pub mod pipeline;
+pub(crate) mod team;
 pub mod threads;
 
 // The modules under their short names, as before the layers: `tumble::shape::Shape`.

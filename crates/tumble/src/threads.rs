@@ -94,8 +94,8 @@ impl Workers {
         self.threads
     }
 
-    /// Runs `f` on this world's pool (so that the stages' parallel loops use its
-    /// threads) with the step's splitting rule; on the calling thread if the world has
+    /// Runs `f` on this world's pool, its threads held as a team for `f`'s length (see
+    /// `team.rs`), with the step's splitting rule; on the calling thread if the world has
     /// one thread, or if no pool can be started (then serially: the results are the
     /// same).
     pub fn run<R: Send>(&mut self, f: impl FnOnce(Par) -> R + Send) -> R {
@@ -110,7 +110,7 @@ impl Workers {
                 let par = Par {
                     threads: self.threads,
                 };
-                pool.install(|| f(par))
+                pool.install(|| crate::team::region(par.threads, || f(par)))
             }
             None => f(Par::SERIAL),
         }

@@ -334,6 +334,9 @@ const ENGAGE: usize = 4;
 /// takes about 0.2 µs a pair, a hand-off a few µs.
 const PAIRS_A_PIECE: usize = 256;
 
+/// Bodies whose motions a piece computes (a motion is a few dozen flops).
+const MOTIONS_A_PIECE: usize = 1024;
+
 /// The broad phase's caps for `limits` and the contact margin (m).
 fn crowding(limits: &ContactLimits, margin: Real) -> Crowding {
     Crowding {
@@ -529,7 +532,6 @@ impl ContactCache {
         joined: &[(u32, u32)],
         (limits, par): (&ContactLimits, Par),
     ) -> bool {
-        use rayon::prelude::*;
         let count = par.pieces(self.pairs.len(), PAIRS_A_PIECE);
         let size = self.pairs.len().div_ceil(count);
         let mut pieces = std::mem::take(&mut self.pieces);
@@ -538,28 +540,38 @@ impl ContactCache {
         // of the rain's landing on two threads).
         let mut motions = std::mem::take(&mut self.motions);
         motions.clear();
-        let n = world.bodies.len();
-        motions.par_extend((0..n).into_par_iter().map(|i| world.motion(i)));
-        let known = Some(&motions[..]);
-        let (previous, order, keys) = (&self.previous, &self.order, &self.keys);
-        pieces
-            .par_iter_mut()
-            .zip(self.pairs.par_chunks(size))
-            .for_each(|((scratch, out), pairs)| {
-                let old = Sorted::of(previous, order, keys);
-                out.clear();
-                scratch.collided = 0;
-                for &(a, b) in pairs {
-                    let (a, b) = (a as usize, b as usize);
-                    let (Some(body_a), Some(body_b)) = (world.bodies.get(a), world.bodies.get(b))
-                    else {
-                        continue;
-                    };
-                    if may_collide(body_a, body_b, (a, b), joined) {
-                        pair_contacts(world, &old, (a, b), broad, (scratch, known), out);
-                    }
+        if let Some(first) = (!world.bodies.is_empty()).then(|| world.motion(0)) {
+            motions.resize(world.bodies.len(), first);
+        }
+        crate::team::chunks(
+            par.threads,
+            &mut motions,
+            MOTIONS_A_PIECE,
+            &|start, part| {
+                for (k, m) in part.iter_mut().enumerate() {
+                    *m = world.motion(start + k);
                 }
-            });
+            },
+        );
+        let known = Some(&motions[..]);
+        let (previous, order, keys, pairs) = (&self.previous, &self.order, &self.keys, &self.pairs);
+        crate::team::chunks(par.threads, &mut pieces, 1, &|i, piece| {
+            let (scratch, out) = &mut piece[0];
+            let old = Sorted::of(previous, order, keys);
+            out.clear();
+            scratch.collided = 0;
+            let mine = &pairs[(i * size).min(pairs.len())..((i + 1) * size).min(pairs.len())];
+            for &(a, b) in mine {
+                let (a, b) = (a as usize, b as usize);
+                let (Some(body_a), Some(body_b)) = (world.bodies.get(a), world.bodies.get(b))
+                else {
+                    continue;
+                };
+                if may_collide(body_a, body_b, (a, b), joined) {
+                    pair_contacts(world, &old, (a, b), broad, (scratch, known), out);
+                }
+            }
+        });
         let total: usize = pieces.iter().map(|(_, out)| out.len()).sum();
         self.collided = pieces.iter().map(|(s, _)| s.collided).sum();
         let fits = total < ENGAGE * world.bodies.len() && total <= limits.per_step as usize;

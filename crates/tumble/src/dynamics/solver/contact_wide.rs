@@ -27,6 +27,7 @@ use super::contact::{ContactConstraint, Point, PointCold, Points, Row};
 use super::lanes::{lane_mode, LaneMode, Lanes, Lanes3, Mask, LANES};
 pub(crate) use super::rows::Pass;
 use super::rows::{self, Frame, Masks, Motion, Pair, Sums};
+use crate::team::Parts;
 use crate::threads::Par;
 
 /// A group's points in lanes, their masks and their sums, as a pass walks them.
@@ -40,12 +41,13 @@ type GroupPoints<'a> = (
 const MIN_LANES: usize = 2;
 
 /// Fewest groups worth a piece of a pass on another thread. A group's pass takes about
-/// 0.3 µs (eight manifolds of four points), but rayon's workers sleep between the
-/// step's many short parallel passes and a wake-up is tens of µs: on the rain's landing
-/// (two threads, this 2-core machine) pieces of 16 groups made the step 15 % slower, of
-/// 32 6 % slower, of 64 as fast as one thread (3.17 against 3.23 ms). Runs are split
-/// only from two pieces, 1,024 manifolds of one colour.
-const GROUPS_A_PIECE: usize = 64;
+/// 0.3 µs (eight manifolds of four points), and a piece handed to the step's team (see
+/// `team.rs`) about a microsecond. On rayon's fork–join, whose workers sleep between the
+/// step's short passes, pieces of 16 groups made the rain's landing 15 % slower on two
+/// threads and 64 broke even; with the team, on Box3D's large pyramid (colours of about
+/// 300 groups), pieces of 4, 16 and 64 groups gave 409, 463 and 402 ms a step on two
+/// threads against 546–576 on one (runs on this 2-core machine vary by 10–20 %).
+const GROUPS_A_PIECE: usize = 32;
 
 /// Up to [`LANES`] consecutive constraints of one colour.
 #[derive(Debug, Clone)]
@@ -482,7 +484,7 @@ fn warm_start_lanes(
                 groups,
                 (&lanes.slots[base..], &lanes.masks[base..], base),
                 shared,
-                pieces,
+                (pieces, par.threads),
             );
             next = run_inner(constraints, groups, |c| c.warm_start(points, states));
             gi = run.end;
@@ -514,74 +516,58 @@ fn run_inner(
     at
 }
 
-/// The groups of a run warm-started in `pieces` pieces on the pool's threads; `slots`
+/// The groups of a run warm-started in `pieces` pieces on the step's team; `slots`
 /// and `masks` start at slot `base`.
 fn warm_start_run(
     groups: &[Group],
     (slots, masks, base): (&[Point<Lanes>], &[Masks<Mask>], usize),
     states: SharedStates<'_>,
-    pieces: usize,
+    (pieces, threads): (usize, usize),
 ) {
-    if pieces <= 1 {
+    let work = |i: usize| {
         let mut states = states;
-        return groups_leaf(groups, |g: &Group| {
+        groups_leaf(&groups[share(groups.len(), pieces, i)], |g: &Group| {
             let span = g.slot0 - base..g.slot0 - base + g.slots;
             g.warm_start(&slots[span.clone()], &masks[span], &mut states);
         });
-    }
-    let mid = groups.len() / 2;
-    let (left, right) = groups.split_at(mid);
-    rayon::join(
-        || warm_start_run(left, (slots, masks, base), states, pieces / 2),
-        || warm_start_run(right, (slots, masks, base), states, pieces - pieces / 2),
-    );
+    };
+    crate::team::pieces(threads, pieces, &work);
 }
 
-/// The groups of a run solved in `pieces` pieces on the pool's threads; the slices
-/// start at slot `base`, and each half gets its own part of them.
+/// Piece `i` of `n` items cut into `pieces` nearly equal consecutive shares.
+fn share(n: usize, pieces: usize, i: usize) -> Range<usize> {
+    n * i / pieces..n * (i + 1) / pieces
+}
+
+/// The groups of a run solved in `pieces` pieces on the step's team; the slices start at
+/// slot `base`, and each piece gets its groups' slots, which no other piece's overlap
+/// (a run's groups hold consecutive slots, in order).
 fn solve_run<const BIAS: bool>(
     groups: &[Group],
     ((slots, masks, cold), base): (GroupPoints<'_>, usize),
     states: SharedStates<'_>,
-    (pass, pieces): (Pass<'_>, usize),
+    (pass, pieces, threads): (Pass<'_>, usize, usize),
 ) {
-    if pieces <= 1 {
+    let (slots, cold) = (Parts::new(slots), Parts::new(cold));
+    let work = |i: usize| {
+        let mine = &groups[share(groups.len(), pieces, i)];
+        let (Some(first), Some(last)) = (mine.first(), mine.last()) else {
+            return;
+        };
+        let span = first.slot0 - base..last.slot0 + last.slots - base;
+        let at = span.start;
+        // SAFETY: the pieces' group shares are disjoint and their slots consecutive, so
+        // the spans of two pieces never overlap.
+        let (slots, cold) = unsafe { (slots.part(span.clone()), cold.part(span)) };
         let mut states = states;
-        return groups_leaf(groups, |g: &Group| {
-            let span = g.slot0 - base..g.slot0 - base + g.slots;
-            let points = (
-                &mut slots[span.clone()],
-                &masks[span.clone()],
-                &mut cold[span],
-            );
+        groups_leaf(mine, |g: &Group| {
+            let span = g.slot0 - base - at..g.slot0 - base - at + g.slots;
+            let masks = &masks[g.slot0 - base..g.slot0 - base + g.slots];
+            let points = (&mut slots[span.clone()], masks, &mut cold[span]);
             g.solve::<BIAS, _>(points, &mut states, pass);
         });
-    }
-    let mid = groups.len() / 2;
-    let (left, right) = groups.split_at(mid);
-    let cut = right[0].slot0 - base;
-    let (slots_l, slots_r) = slots.split_at_mut(cut);
-    let (cold_l, cold_r) = cold.split_at_mut(cut);
-    let (masks_l, masks_r) = masks.split_at(cut);
-    let at = right[0].slot0;
-    rayon::join(
-        || {
-            solve_run::<BIAS>(
-                left,
-                ((slots_l, masks_l, cold_l), base),
-                states,
-                (pass, pieces / 2),
-            )
-        },
-        || {
-            solve_run::<BIAS>(
-                right,
-                ((slots_r, masks_r, cold_r), at),
-                states,
-                (pass, pieces - pieces / 2),
-            )
-        },
-    );
+    };
+    crate::team::pieces(threads, pieces, &work);
 }
 
 /// `each` over a piece of a run, compiled for AVX2 when the lanes use it (the closure,
@@ -716,9 +702,9 @@ fn solve_run_in_place(
     // SAFETY: `add_run` checked the run: a moving body in one lane of it only.
     let shared = unsafe { SharedStates::new(states) };
     if pass.bias {
-        solve_run::<true>(groups, slices, shared, (pass, pieces));
+        solve_run::<true>(groups, slices, shared, (pass, pieces, par.threads));
     } else {
-        solve_run::<false>(groups, slices, shared, (pass, pieces));
+        solve_run::<false>(groups, slices, shared, (pass, pieces, par.threads));
     }
     let lanes_end = |p: &Points, g: usize| p.lanes.groups[g].first + p.lanes.groups[g].lanes;
     let mut at = lanes_end(points, span.start);

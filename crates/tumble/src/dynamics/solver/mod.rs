@@ -53,6 +53,10 @@ use crate::math::{Mat3, Real, Vec3};
 use crate::threads::Par;
 use std::ops::Range;
 
+/// Fewest bodies worth a piece of a kick or a drift on another thread (a body's is some
+/// 50 ns: a piece of 256 is over ten times a hand-off's cost).
+const BODIES_A_PIECE: usize = 256;
+
 /// What the solver needs of a step.
 pub(crate) struct StepInput<'a, 'b> {
     pub system: &'a mut System<'b>,
@@ -403,17 +407,16 @@ impl Solver {
 
     /// The tall stacks' bodies' kick over `h`, with the forces of the world's substep.
     fn kick_tall(&mut self, bodies: &mut SolverBodies, world_bodies: &[Body], h: Real) {
-        for (k, ((sim, state), body)) in bodies
-            .sims
-            .iter_mut()
-            .zip(&mut bodies.states)
-            .zip(world_bodies)
-            .enumerate()
-        {
-            if is_flagged(&self.tall, k) {
-                kick_body((sim, state), &self.wrench[k], body, h);
+        let (tall, wrench) = (&self.tall, &self.wrench);
+        let work = |start: usize, sims: &mut [BodySim], states: &mut [BodyState]| {
+            for (j, (sim, state)) in sims.iter_mut().zip(states).enumerate() {
+                let k = start + j;
+                if is_flagged(tall, k) {
+                    kick_body((sim, state), &wrench[k], &world_bodies[k], h);
+                }
             }
-        }
+        };
+        self.per_body(bodies, &work);
     }
 
     /// Marks the bodies of islands with a large mass ratio (see `mass_ratio`), over the
@@ -671,24 +674,35 @@ impl Solver {
         if evaluate {
             self.evaluate_forces(bodies, system, t);
         }
-        for (k, ((((sim, state), w), body), &split)) in bodies
-            .sims
-            .iter_mut()
-            .zip(&mut bodies.states)
-            .zip(&self.wrench)
-            .zip(system.bodies)
-            .zip(&self.split_kick)
-            .enumerate()
-        {
-            let h = match (split, end) {
-                (true, _) => 0.5 * h,
-                (false, false) => h,
-                (false, true) => continue,
-            };
-            if sim.moves && !is_flagged(&self.tall, k) {
-                kick_body((sim, state), w, body, h);
+        let (wrench, split_kick, tall) = (&self.wrench, &self.split_kick, &self.tall);
+        let world_bodies = system.bodies;
+        let work = |start: usize, sims: &mut [BodySim], states: &mut [BodyState]| {
+            for (j, (sim, state)) in sims.iter_mut().zip(states).enumerate() {
+                let k = start + j;
+                let h = match (split_kick[k], end) {
+                    (true, _) => 0.5 * h,
+                    (false, false) => h,
+                    (false, true) => continue,
+                };
+                if sim.moves && !is_flagged(tall, k) {
+                    kick_body((sim, state), &wrench[k], &world_bodies[k], h);
+                }
             }
-        }
+        };
+        self.per_body(bodies, &work);
+    }
+
+    /// `work(start, sims, states)` over the bodies in pieces of [`BODIES_A_PIECE`] on
+    /// the step's team; each body's update must read no other body's state.
+    fn per_body(
+        &self,
+        bodies: &mut SolverBodies,
+        work: &crate::team::PairWork<'_, BodySim, BodyState>,
+    ) {
+        let n = bodies.sims.len();
+        let size = n.div_ceil(self.par.pieces(n, BODIES_A_PIECE));
+        let pair = (&mut bodies.sims[..], &mut bodies.states[..]);
+        crate::team::chunks2(self.par.threads, pair, size, work);
     }
 
     /// Every force element and callback at the solver's current state and time `t`.
@@ -704,37 +718,41 @@ impl Solver {
     /// (`tall`) or the others; kinematic bodies move with the others, so contacts see them
     /// where they are.
     fn drift(&mut self, solver_bodies: &mut SolverBodies, bodies: &[Body], h: Real, tall: bool) {
-        let (sims, states) = (&mut solver_bodies.sims, &mut solver_bodies.states);
-        for (k, ((sim, state), body)) in sims
-            .iter_mut()
-            .zip(states.iter_mut())
-            .zip(bodies)
-            .enumerate()
-        {
-            if is_flagged(&self.tall, k) != tall {
-                continue;
-            }
-            match (sim.moves, body.kind) {
-                (true, _) => {
-                    // The ω the substep's rows saw: the one the drift turns with.
-                    state.turned += state.w * h;
-                    sim.sync_momentum(state);
-                    sim.x += state.v * h;
-                    sim.q = rotor_drift(body, sim.q, sim.l, state.w, h);
-                    state.w = body.omega_from_momentum(sim.q, sim.l);
-                    sim.w_synced = state.w;
+        let flags = &self.tall;
+        let work = |start: usize, sims: &mut [BodySim], states: &mut [BodyState]| {
+            for (j, (sim, state)) in sims.iter_mut().zip(states).enumerate() {
+                let k = start + j;
+                if is_flagged(flags, k) == tall {
+                    drift_body((sim, state), &bodies[k], h);
                 }
-                (false, BodyKind::Kinematic) => {
-                    state.turned += state.w * h;
-                    sim.x += state.v * h;
-                    sim.q = exact_spin(state.w, sim.q, h);
-                }
-                _ => continue,
             }
-            state.dp = sim.x - sim.x0;
-            state.dr = Mat3::from_quat(sim.q * sim.q0.inverse());
-        }
+        };
+        self.per_body(solver_bodies, &work);
     }
+}
+
+/// x += h v and the exact torque-free rotation with L for a body the solver moves; a
+/// kinematic body moves with its velocities; others stay.
+fn drift_body((sim, state): (&mut BodySim, &mut BodyState), body: &Body, h: Real) {
+    match (sim.moves, body.kind) {
+        (true, _) => {
+            // The ω the substep's rows saw: the one the drift turns with.
+            state.turned += state.w * h;
+            sim.sync_momentum(state);
+            sim.x += state.v * h;
+            sim.q = rotor_drift(body, sim.q, sim.l, state.w, h);
+            state.w = body.omega_from_momentum(sim.q, sim.l);
+            sim.w_synced = state.w;
+        }
+        (false, BodyKind::Kinematic) => {
+            state.turned += state.w * h;
+            sim.x += state.v * h;
+            sim.q = exact_spin(state.w, sim.q, h);
+        }
+        _ => return,
+    }
+    state.dp = sim.x - sim.x0;
+    state.dr = Mat3::from_quat(sim.q * sim.q0.inverse());
 }
 
 /// v += h F/m, L += h N for one body the solver moves. A damped body's kick is wrapped

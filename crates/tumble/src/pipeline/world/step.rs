@@ -40,8 +40,11 @@ use crate::math::{Real, Vec3};
 use crate::pipeline::world::World;
 use crate::threads::Par;
 
-/// Fewest bodies for which a step goes to the world's threads at all.
-const SMALL_WORLD: usize = 256;
+/// Fewest bodies for which a step goes to the world's threads at all. The bench's
+/// 385-cube pyramid (graph colours of at most 31 lane groups, too short to split) took
+/// 0.72–0.93× its one-thread speed on two threads with the team formed: below about a
+/// thousand bodies nothing splits enough to pay for it.
+const SMALL_WORLD: usize = 1000;
 
 /// Everything a step builds and throws away, kept between steps only so that stepping
 /// allocates nothing. Nothing here is read before the step that needs it writes it.
@@ -84,8 +87,8 @@ impl World {
     pub fn step(&mut self, dt: Real) -> Result<()> {
         check::positive("dt", dt)?;
         // A small world steps on the calling thread: handing a step to the pool and back
-        // costs tens of µs, more than a few hundred bodies' stages could save (and none
-        // of them splits below that size).
+        // costs tens of µs, and a team whose members spin costs a core, more than a few
+        // hundred bodies' stages could save.
         if Par::split_at(self.bodies.list.len(), SMALL_WORLD) == 0 {
             return self.step_on(dt, Par::SERIAL);
         }
