@@ -155,7 +155,8 @@ fn bodies_from_the_side_and_below_pass_through() {
     }
     assert!(!touched, "a contact held");
     let x = w.body(side).unwrap().center_of_mass().x;
-    assert!((x - 3.0).abs() < 1e-9, "x {x}");
+    // 120 additions of v dt: rounding only (f32 carries about 7 digits).
+    assert!((x - 3.0).abs() < tol(1e-9, 1e-4), "x {x}");
 }
 
 /// The platform's normal turns with it: turned −90° about z (its normal now +x), it stops
@@ -201,7 +202,7 @@ fn the_normal_is_in_the_body_frame() {
         "x {x}, v {vx}"
     );
     let passed = w.body(from_minus).unwrap().center_of_mass().x;
-    assert!((passed - 1.0).abs() < 1e-9, "passed to {passed}");
+    assert!((passed - 1.0).abs() < tol(1e-9, 1e-4), "passed to {passed}");
 }
 
 /// `one_way` is checked as the scene loader checks it (finite, non-zero) and normalised;

@@ -465,7 +465,8 @@ impl World {
     }
 
     /// Runs the broad and narrow phases on the current state and returns every contact
-    /// manifold; points keep last update's impulses where their feature ids match. At most
+    /// manifold; points keep last update's impulses where their feature ids match. The
+    /// contact filter, one-way bodies and the contact modifier act as in a step. At most
     /// [`ContactLimits::per_step`] are returned (a step that needs more fails).
     pub fn update_contacts(&mut self) -> &[Contact] {
         let mut workers = std::mem::take(&mut self.workers);
