@@ -1,5 +1,5 @@
 //! The CSV files a run writes: the trajectory (`--out`), the diagnostics
-//! (`--diagnostics`), contacts and joints. Numbers are printed so that they read back bit for bit, and the
+//! (`--diagnostics`), contacts, joints and sensor events. Numbers are printed so that they read back bit for bit, and the
 //! same run always writes the same bytes.
 
 use std::fmt;
@@ -17,6 +17,8 @@ pub const CONTACT_IMPULSES_HEADER: &str =
 /// Header of the joints file.
 pub const JOINT_REACTIONS_HEADER: &str = "time,joint,body,other,fx,fy,fz,tx,ty,tz,broken,\
 position,velocity,position_x,position_y,position_z,velocity_x,velocity_y,velocity_z";
+/// Header of the sensor events file.
+pub const SENSOR_EVENTS_HEADER: &str = "time,sensor,body,began";
 /// Header of the diagnostics file.
 pub const DIAGNOSTICS_HEADER: &str = "time,kinetic,potential,total,px,py,pz,lx,ly,lz";
 
@@ -168,6 +170,28 @@ impl CsvFile {
                     ),
                 )?;
             }
+        }
+        Ok(())
+    }
+
+    /// A row per sensor event of the last step: its time, the sensor's and the body's
+    /// labels, and 1 if the overlap began, 0 if it ended.
+    pub fn sensors(&mut self, world: &World, labels: &[String]) -> Result<(), Failure> {
+        let events = world.sensor_events();
+        if events.is_empty() {
+            return Ok(());
+        }
+        let label = labeller(world, labels);
+        for e in events {
+            self.row(
+                e.time,
+                format_args!(
+                    "{},{},{}",
+                    csv_text(label(e.sensor)),
+                    csv_text(label(e.body)),
+                    u8::from(e.began)
+                ),
+            )?;
         }
         Ok(())
     }

@@ -9,7 +9,8 @@ use tumble_scene::{RunPlan, Scene, SceneError, MAX_PASSES, MAX_STEPS};
 use crate::args::{number, whole, whole_u32};
 use crate::output::{check_distinct, inputs, scene_file, Target};
 use crate::record::{
-    CsvFile, CONTACT_IMPULSES_HEADER, DIAGNOSTICS_HEADER, JOINT_REACTIONS_HEADER, TRAJECTORY_HEADER,
+    CsvFile, CONTACT_IMPULSES_HEADER, DIAGNOSTICS_HEADER, JOINT_REACTIONS_HEADER,
+    SENSOR_EVENTS_HEADER, TRAJECTORY_HEADER,
 };
 use crate::report::{SeedTable, Summary};
 use crate::Failure;
@@ -81,6 +82,12 @@ pub struct RunArgs {
     #[arg(long, value_name = "FILE")]
     pub joints: Option<PathBuf>,
 
+    /// Write every sensor event as CSV to FILE, whatever --every says: time (s, the end of
+    /// the step that found it), sensor and body (names, or indices), began (1 when the
+    /// body started overlapping the sensor, 0 when it stopped).
+    #[arg(long, value_name = "FILE")]
+    pub sensors: Option<PathBuf>,
+
     /// Contact solver; overrides the scene's `solver`: soft_step (default) or pgs.
     #[arg(long, value_name = "NAME")]
     pub solver: Option<String>,
@@ -127,6 +134,7 @@ impl Default for RunArgs {
             diagnostics: None,
             contacts: None,
             joints: None,
+            sensors: None,
             solver: None,
             substeps: None,
             iterations: None,
@@ -231,6 +239,7 @@ struct Sinks {
     diagnostics: Option<CsvFile>,
     contacts: Option<CsvFile>,
     joints: Option<CsvFile>,
+    sensors: Option<CsvFile>,
     seed_table: Option<SeedTable>,
     summary: Option<Summary>,
     labels: Vec<String>,
@@ -249,13 +258,14 @@ impl Sinks {
             check("diagnostics", &args.diagnostics)?,
             check("contacts", &args.contacts)?,
             check("joints", &args.joints)?,
+            check("sensors", &args.sensors)?,
         ];
         let scene_file = args.scene.as_deref().and_then(scene_file);
         check_distinct(
             &targets.iter().flatten().collect::<Vec<_>>(),
             &inputs(&scene_file),
         )?;
-        let [out, diagnostics, contacts, joints] = targets;
+        let [out, diagnostics, contacts, joints, sensors] = targets;
         let csv =
             |target: Option<Target>, header| target.map(|t| CsvFile::create(t, header)).transpose();
         let seed = args.scene.is_none() && !args.quiet;
@@ -264,6 +274,7 @@ impl Sinks {
             diagnostics: csv(diagnostics, DIAGNOSTICS_HEADER)?,
             contacts: csv(contacts, CONTACT_IMPULSES_HEADER)?,
             joints: csv(joints, JOINT_REACTIONS_HEADER)?,
+            sensors: csv(sensors, SENSOR_EVENTS_HEADER)?,
             seed_table: seed
                 .then(|| SeedTable::new(&scene.world, plan))
                 .transpose()?,
@@ -276,6 +287,10 @@ impl Sinks {
     /// After step `k` (0: the initial state) at `time`; `record` says whether the CSV
     /// files take this step.
     fn observe(&mut self, k: u64, time: Real, world: &World, record: bool) -> Result<(), Failure> {
+        // Events are written at every step: a recorded step would miss a short visit.
+        if let Some(csv) = self.sensors.as_mut().filter(|_| k > 0) {
+            csv.sensors(world, &self.labels)?;
+        }
         if record {
             self.record(time, world)?;
         }
@@ -311,6 +326,7 @@ impl Sinks {
             self.diagnostics,
             self.contacts,
             self.joints,
+            self.sensors,
         ]
         .into_iter()
         .flatten()

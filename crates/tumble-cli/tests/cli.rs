@@ -539,3 +539,52 @@ fn joint_reactions_are_written_and_carry_the_load() {
     );
     assert!(last[8].abs() < 0.05, "rate {}", last[8]);
 }
+
+#[test]
+fn sensor_events_are_written_at_every_step() {
+    // A ball of radius 0.1 dropped from y = 5 through a sensor slab y in [1, 2]: it enters
+    // when its bottom reaches 2, at t = √(2·2.9/g), and leaves when its top passes 1, at
+    // t = √(2·4.1/g); each event lies within a step (dt = 0.01 s) of those times, and both
+    // are written though --every records only the first and last steps.
+    let dir = scratch("sensors_csv");
+    let scene = dir.join("gate.json");
+    std::fs::write(
+        &scene,
+        r#"{"dt": 0.01, "duration": 1.5, "bodies": [
+            {"name": "gate", "kind": "static", "sensor": true, "position": [0, 1.5, 0],
+             "shape": {"type": "box", "half_extents": [2, 0.5, 2]}},
+            {"name": "ball", "position": [0, 5, 0], "shape": {"type": "sphere", "radius": 0.1}}
+        ]}"#,
+    )
+    .unwrap();
+    let file = dir.join("sensors.csv");
+    let run = |file: &Path| {
+        ok(&[
+            "run",
+            path(&scene),
+            "--sensors",
+            path(file),
+            "--every",
+            "1000",
+            "--quiet",
+        ])
+    };
+    run(&file);
+    let (header, rows) = rows(&file);
+    assert_eq!(header, "time,sensor,body,began");
+    assert_eq!(rows.len(), 2, "{rows:?}");
+    for (row, (drop, began)) in rows.iter().zip([(2.9, "1"), (4.1, "0")]) {
+        let t = (2.0 * drop / 9.8_f64).sqrt();
+        assert!((num(&row[0]) - t).abs() <= 0.01, "{row:?} vs {t}");
+        assert_eq!(row[1..], ["gate", "ball", began]);
+    }
+    let again = dir.join("again.csv");
+    run(&again);
+    assert_eq!(
+        std::fs::read(&file).unwrap(),
+        std::fs::read(&again).unwrap()
+    );
+    let line = refused(&["run", path(&scene), "--sensors", path(&dir)]);
+    assert!(line.starts_with("sensors: '") && line.ends_with("is a folder; name a file"));
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -12,7 +12,7 @@ use crate::world::{Inner, PyWorld};
 /// A body in a world. Its properties read the live state (arrays are fresh copies); the
 /// assignable ones (position, orientation, velocity, angular_velocity, friction,
 /// restitution, collision_group, collision_mask, linear_damping, angular_damping,
-/// gravity_scale) edit it, checked as `add_body` checks them, and wake it. Handles of
+/// gravity_scale, sensor, one_way) edit it, checked as `add_body` checks them, and wake it. Handles of
 /// a removed body raise ValueError. Two handles of the same body compare equal.
 #[pyclass(module = "tumble", name = "Body", frozen)]
 pub struct PyBody {
@@ -270,6 +270,33 @@ impl PyBody {
     #[setter]
     fn set_gravity_scale(&self, value: f64) -> PyResult<()> {
         self.edit(|g, id| g.world.set_gravity_scale(id, real(value)))
+    }
+
+    /// Whether the body is a sensor (reports overlaps, no contact response); assignable.
+    #[getter]
+    fn sensor(&self) -> PyResult<bool> {
+        self.read(Body::is_sensor)
+    }
+
+    #[setter]
+    fn set_sensor(&self, value: bool) -> PyResult<()> {
+        self.edit(|g, id| g.world.set_sensor(id, value))
+    }
+
+    /// A one-way body's unit normal (body frame), or None; assignable (any non-zero
+    /// length, normalised; None makes it an ordinary body).
+    #[getter]
+    fn one_way<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray1<f64>>>> {
+        Ok(self.read(Body::one_way)?.map(|n| vec3_out(py, n)))
+    }
+
+    #[setter]
+    fn set_one_way(&self, value: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
+        let normal = value
+            .filter(|n| !n.is_none())
+            .map(|n| vec3(n, "one_way"))
+            .transpose()?;
+        self.edit(|g, id| g.world.set_one_way(id, normal))
     }
 
     /// Makes a kinematic body arrive exactly at `position` (m, its frame's origin) and

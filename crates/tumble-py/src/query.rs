@@ -126,6 +126,29 @@ impl ContactEvent {
     }
 }
 
+/// A body started or stopped overlapping a sensor: the `sensor` and the `body` (handles),
+/// `began` (True when the overlap started, False when it ended) and the simulated `time`
+/// (s) it was seen at (the end of the step that found it, or of the edit that ended it).
+#[pyclass(module = "tumble", name = "SensorEvent", frozen, get_all)]
+pub struct SensorEvent {
+    /// The sensor.
+    sensor: Py<PyBody>,
+    /// The body that entered or left it.
+    body: Py<PyBody>,
+    /// True when the overlap began.
+    began: bool,
+    /// When (s).
+    time: f64,
+}
+
+#[pymethods]
+impl SensorEvent {
+    fn __repr__(&self) -> String {
+        let what = if self.began { "began" } else { "ended" };
+        format!("<tumble.SensorEvent {what} t={}>", self.time)
+    }
+}
+
 fn filter(
     slf: &Bound<'_, PyWorld>,
     g: &Inner,
@@ -382,6 +405,38 @@ impl PyWorld {
             })
             .collect()
     }
+
+    /// The sensor events of the last step, in (sensor, body) order: bodies that began or
+    /// stopped overlapping a sensor. End events of edits made before the step (a body
+    /// removed, a sensor flag changed) come first, with the time of the edit.
+    fn sensor_events(slf: &Bound<'_, Self>) -> PyResult<Vec<SensorEvent>> {
+        let events = slf.get().lock()?.world.sensor_events().to_vec();
+        events
+            .into_iter()
+            .map(|e| {
+                Ok(SensorEvent {
+                    sensor: handle(slf, e.sensor)?.unbind(),
+                    body: handle(slf, e.body)?.unbind(),
+                    began: e.began,
+                    time: wide(e.time),
+                })
+            })
+            .collect()
+    }
+
+    /// The bodies overlapping `sensor` (a handle or a name) as of the last step; empty for
+    /// a body that is not a sensor.
+    fn sensor_overlaps<'py>(
+        slf: &Bound<'py, Self>,
+        sensor: &Bound<'py, PyAny>,
+    ) -> PyResult<Vec<Bound<'py, PyBody>>> {
+        let ids = {
+            let g = slf.get().lock()?;
+            let id = body_arg(slf, &g, sensor, "sensor")?;
+            g.world.sensor_overlaps(id).map_err(engine)?
+        };
+        bodies(slf, ids)
+    }
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -390,5 +445,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Contact>()?;
     m.add_class::<ContactPoint>()?;
     m.add_class::<ContactEvent>()?;
+    m.add_class::<SensorEvent>()?;
     Ok(())
 }

@@ -412,13 +412,17 @@ impl PyWorld {
     /// μ_t N; a pair uses the larger of each), `collision_group`/`collision_mask`
     /// (32-bit layer sets), `bullet` (continuous collision against every body that is
     /// not a bullet), `linear_damping` and `angular_damping` (1/s: dv/dt = −c v,
-    /// dL/dt = −c L besides the forces) and `gravity_scale` (times the world's gravity).
+    /// dL/dt = −c L besides the forces), `gravity_scale` (times the world's gravity),
+    /// `sensor` (reports overlaps in `sensor_events()`, with no contact response) and
+    /// `one_way` (a platform's normal, body frame: bodies from that side land on it, from
+    /// below or the side pass through).
     #[pyo3(signature = (shape, *, mass = None, density = None, position = None,
         orientation = None, velocity = None, angular_velocity = None,
         kind = "dynamic".to_string(), name = None, planar = false, inertia = None,
         center_of_mass = None, friction = 0.6, restitution = 0.0, rolling_resistance = 0.0,
         torsional_friction = 0.0, collision_group = 1, collision_mask = 0xFFFF_FFFF,
-        bullet = false, linear_damping = 0.0, angular_damping = 0.0, gravity_scale = 1.0))]
+        bullet = false, linear_damping = 0.0, angular_damping = 0.0, gravity_scale = 1.0,
+        sensor = false, one_way = None))]
     #[allow(clippy::too_many_arguments)]
     fn add_body<'py>(
         slf: &Bound<'py, Self>,
@@ -444,6 +448,8 @@ impl PyWorld {
         linear_damping: f64,
         angular_damping: f64,
         gravity_scale: f64,
+        sensor: bool,
+        one_way: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyBody>> {
         let shape = shape_of(shape, "shape")?;
         let mass = match (mass, density) {
@@ -487,6 +493,11 @@ impl PyWorld {
             linear_damping: real(linear_damping),
             angular_damping: real(angular_damping),
             gravity_scale: real(gravity_scale),
+            sensor,
+            one_way: one_way
+                .filter(|n| !n.is_none())
+                .map(|n| vec3(n, "one_way"))
+                .transpose()?,
         };
         let id = slf
             .get()

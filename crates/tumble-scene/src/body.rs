@@ -5,7 +5,7 @@ use tumble::{BodyDef, BodyKind, InertiaSpec, MassSpec, Mat3, Quat, Shape, Vec3};
 use crate::error::{printable, Result};
 use crate::reader::{Node, Obj};
 
-const BODY_KEYS: [&str; 23] = [
+const BODY_KEYS: [&str; 25] = [
     "name",
     "kind",
     "shape",
@@ -29,6 +29,8 @@ const BODY_KEYS: [&str; 23] = [
     "linear_damping",
     "angular_damping",
     "gravity_scale",
+    "sensor",
+    "one_way",
 ];
 
 /// A body's `color`, `"#rrggbb"`: for pictures and the viewer only, never for physics.
@@ -79,6 +81,8 @@ pub(crate) fn body(node: &Node<'_>) -> Result<(BodyDef, Shape)> {
         linear_damping: obj.real("linear_damping")?.unwrap_or(0.0),
         angular_damping: obj.real("angular_damping")?.unwrap_or(0.0),
         gravity_scale: obj.real("gravity_scale")?.unwrap_or(1.0),
+        sensor: obj.bool("sensor")?.unwrap_or(false),
+        one_way: obj.vec3("one_way")?,
     };
     let shape = crate::shape::shape(&obj.required("shape")?)?;
     Ok((def, shape))

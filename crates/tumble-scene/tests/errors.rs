@@ -47,7 +47,8 @@ fn misspelt_keys_are_refused_with_the_allowed_ones() {
         "bodies[0].velocty: unknown key (expected one of: name, kind, shape, mass, density, \
          inertia, center_of_mass, position, orientation, velocity, angular_velocity, planar, \
          collision_group, collision_mask, friction, restitution, rolling_resistance, \
-         torsional_friction, bullet, color, linear_damping, angular_damping, gravity_scale)"
+         torsional_friction, bullet, color, linear_damping, angular_damping, gravity_scale, \
+         sensor, one_way)"
     );
     assert_eq!(
         error(&with_forces(
@@ -448,4 +449,28 @@ fn the_push_out_speed_is_read_and_checked() {
     // The default follows the length unit, as Box2D's does.
     let scene = tumble_scene::load_str(r#"{"length_unit": 0.01}"#).unwrap();
     assert!((scene.world.max_push_speed() - 0.03).abs() < 1e-6);
+}
+
+#[test]
+fn sensor_and_one_way_are_checked_with_their_paths() {
+    assert_eq!(
+        error(&one_body(r#""one_way": [0, 0, 0]"#)),
+        "bodies[0].one_way: must be a non-zero vector"
+    );
+    assert_eq!(
+        error(&one_body(r#""one_way": [0, 1]"#)),
+        "bodies[0].one_way: expected an array of 3 numbers [x, y, z]"
+    );
+    assert_eq!(
+        error(&one_body(r#""one_way": [0, 1e400, 0]"#)),
+        "bodies[0].one_way[1]: must be a finite number"
+    );
+    assert_eq!(
+        error(&one_body(r#""sensor": 1"#)),
+        "bodies[0].sensor: expected true or false"
+    );
+    let scene = load_str(&one_body(r#""sensor": true, "one_way": [0, 2, 0]"#)).unwrap();
+    let (_, body) = scene.world.bodies().next().unwrap();
+    assert!(body.is_sensor());
+    assert_eq!(body.one_way(), Some(tumble::Vec3::Y));
 }

@@ -29,7 +29,7 @@ pub mod threads;
 pub use collision::{broad_phase, geometry, narrow_phase, query, shape};
 pub use dynamics::{body, force, integrate, joint, solver};
 pub use pipeline::world::query as world_query;
-pub use pipeline::{analysis, contact_cache, diagnostics, world};
+pub use pipeline::{analysis, contact_cache, diagnostics, hooks, sensors, world};
 
 pub use body::{Body, BodyDef, BodyKind, InertiaSpec, MassSpec};
 pub use collision::contact::{Contact, ContactEvent, ContactEventKind};
@@ -39,12 +39,14 @@ pub use force::{
     AppliedForce, Drag, Force, ForceCallback, ForceContext, Spring, SpringEnd, Wrench,
 };
 pub use geometry::{Aabb, Pose, Ray, RayHit};
+pub use hooks::{ContactMaterial, ContactModification, ContactPair};
 pub use id::{BodyId, ForceId};
 pub use integrate::Integrator;
 pub use joint::{Joint, JointCoordinate, JointDef, JointId, JointKind, JointSpring, Motor, Servo};
 pub use limits::SpeedLimits;
 pub use math::{Mat3, Quat, Real, Vec3};
 pub use narrow_phase::{ContactPoint, Manifold};
+pub use sensors::SensorEvent;
 pub use shape::Convex;
 pub use shape::{CompoundChild, ConvexHull, HeightField, MassProperties, Shape, TriMesh};
 pub use solver::{SolverKind, SolverSettings};
@@ -54,9 +56,10 @@ pub use world_query::{QueryFilter, WorldRayHit, WorldShapeHit};
 /// Everything a typical user needs, in one import.
 pub mod prelude {
     pub use crate::{
-        AppliedForce, Body, BodyDef, BodyId, BodyKind, CompoundChild, Diagnostics, Drag, Error,
-        Force, ForceContext, ForceId, InertiaSpec, Integrator, JointDef, JointId, JointKind,
-        JointSpring, MassSpec, Mat3, Motor, Quat, Real, Servo, Shape, SolverKind, SolverSettings,
-        Spring, SpringEnd, Vec3, World, WorldDef,
+        AppliedForce, Body, BodyDef, BodyId, BodyKind, CompoundChild, ContactModification,
+        ContactPair, Diagnostics, Drag, Error, Force, ForceContext, ForceId, InertiaSpec,
+        Integrator, JointDef, JointId, JointKind, JointSpring, MassSpec, Mat3, Motor, Quat, Real,
+        SensorEvent, Servo, Shape, SolverKind, SolverSettings, Spring, SpringEnd, Vec3, World,
+        WorldDef,
     };
 }

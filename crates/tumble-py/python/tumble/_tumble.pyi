@@ -197,6 +197,16 @@ class Body:
         """Multiplier of the world's gravity for this body; assignable."""
     @gravity_scale.setter
     def gravity_scale(self, value: float) -> None: ...
+    @property
+    def sensor(self) -> bool:
+        """Whether the body is a sensor (reports overlaps, no contact response); assignable."""
+    @sensor.setter
+    def sensor(self, value: bool) -> None: ...
+    @property
+    def one_way(self) -> Optional[F64Array]:
+        """A one-way body's unit normal (body frame), or None; assignable (None: an ordinary body)."""
+    @one_way.setter
+    def one_way(self, value: Optional[Vec3Like]) -> None: ...
     def set_kinematic_target(
         self, position: Vec3Like, orientation: Optional[QuatLike] = None
     ) -> None:
@@ -310,6 +320,14 @@ class ContactEvent:
     kind: Literal["begin", "end"]
     body_a: Body
     body_b: Body
+
+class SensorEvent:
+    """A body began or stopped overlapping a sensor at `time` (s)."""
+
+    sensor: Body
+    body: Body
+    began: bool
+    time: float
 
 class Motor:
     """A velocity motor: `speed` (rad/s or m/s) with at most `max_force` (N·m or N)."""
@@ -459,6 +477,8 @@ class World:
         linear_damping: float = 0.0,
         angular_damping: float = 0.0,
         gravity_scale: float = 1.0,
+        sensor: bool = False,
+        one_way: Optional[Vec3Like] = None,
     ) -> Body:
         """Adds a body and returns its handle."""
     def remove_body(self, body: BodyLike) -> None:
@@ -623,6 +643,10 @@ class World:
         """Collision detection on the current state, without a step."""
     def contact_events(self) -> list[ContactEvent]:
         """Pairs that began or ended touching at the last step."""
+    def sensor_events(self) -> list[SensorEvent]:
+        """Bodies that began or stopped overlapping a sensor at the last step, in (sensor, body) order."""
+    def sensor_overlaps(self, sensor: BodyLike) -> list[Body]:
+        """The bodies overlapping `sensor` as of the last step (empty for a body that is not a sensor)."""
     @property
     def time(self) -> float: ...
     @property

@@ -23,6 +23,40 @@ pub struct Contact {
     /// The pair's geometry when the manifold was last computed, to reuse it while the
     /// bodies hardly move relative to each other.
     pub(crate) basis: Basis,
+    /// Whether no contact with this key existed at the update before (the contact
+    /// modifier's `is_new`).
+    pub(crate) new: bool,
+    /// A one-way body's decision on this manifold, kept while the manifold persists
+    /// (see `pipeline/hooks.rs`).
+    pub(crate) gate: Gate,
+    /// Whether a hook (a one-way body or the contact modifier) took points out of the
+    /// manifold at this update: its basis no longer describes it, so it is not reused.
+    pub(crate) edited: bool,
+}
+
+/// The material of one manifold for one step: what the solver uses.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactMaterial {
+    /// Coulomb friction coefficient (dimensionless); by default √(μ_a μ_b).
+    pub friction: Real,
+    /// Coefficient of restitution in [0, 1]; by default the larger of the two.
+    pub restitution: Real,
+    /// The velocity (m/s, world frame) at which body a's surface carries body b along:
+    /// friction drives b's contact points to move at this velocity relative to a's (a
+    /// conveyor belt). Only its part along the contact plane counts. Default zero.
+    pub surface_velocity: Vec3,
+}
+
+/// What a one-way body decided about a manifold with it (see `pipeline/hooks.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(crate) enum Gate {
+    /// Not yet decided: the manifold is new, or no one-way body is in the pair.
+    #[default]
+    New,
+    /// The other body came from the normal's side: the contact holds it.
+    Keep,
+    /// The other body came from below or the side: it passes through.
+    Pass,
 }
 
 /// A manifold's points and normal in the bodies' own frames, and B's pose in A's frame,

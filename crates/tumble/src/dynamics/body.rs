@@ -116,6 +116,16 @@ pub struct BodyDef {
     /// Multiplier of the world's gravity for this body (dimensionless, finite, |s| <=
     /// `limits::MAX_GRAVITY_SCALE`; negative rises). Default 1.
     pub gravity_scale: Real,
+    /// A sensor detects the bodies it overlaps and reports when each starts and stops
+    /// overlapping (`World::sensor_events`), with no contact response: it neither pushes
+    /// nor is pushed, and a dynamic sensor still falls. Sensors do not detect each other.
+    /// Default false.
+    pub sensor: bool,
+    /// A one-way body (a platform) collides only with bodies that come at it from the side
+    /// its normal points to (body frame; any non-zero length, normalised on creation):
+    /// they land on it, while bodies from below or the sides pass through. `None`
+    /// (default): an ordinary body.
+    pub one_way: Option<Vec3>,
 }
 
 impl Default for BodyDef {
@@ -141,6 +151,8 @@ impl Default for BodyDef {
             linear_damping: 0.0,
             angular_damping: 0.0,
             gravity_scale: 1.0,
+            sensor: false,
+            one_way: None,
         }
     }
 }
@@ -163,6 +175,10 @@ pub struct Body {
     pub(crate) angular_damping: Real,
     /// Multiplier of the world's gravity (see [`BodyDef::gravity_scale`]).
     pub(crate) gravity_scale: Real,
+    /// Whether the body is a sensor (see [`BodyDef::sensor`]).
+    pub(crate) sensor: bool,
+    /// A one-way body's unit normal in its own frame (see [`BodyDef::one_way`]).
+    pub(crate) one_way: Option<Vec3>,
     /// A kinematic body's pose to reach at the end of the next step (centre of mass,
     /// orientation), resolved into velocities when that step begins (see
     /// `World::set_kinematic_target`).
@@ -235,6 +251,8 @@ impl Body {
             linear_damping: def.linear_damping,
             angular_damping: def.angular_damping,
             gravity_scale: def.gravity_scale,
+            sensor: def.sensor,
+            one_way: def.one_way.map(check_one_way).transpose()?,
             kinematic_target: None,
             ccd_extent: 0.0,
             ccd_reach: 0.0,
@@ -318,6 +336,14 @@ impl Body {
     pub fn gravity_scale(&self) -> Real {
         self.gravity_scale
     }
+    /// Whether the body is a sensor (see [`BodyDef::sensor`]).
+    pub fn is_sensor(&self) -> bool {
+        self.sensor
+    }
+    /// A one-way body's unit normal, body frame (see [`BodyDef::one_way`]).
+    pub fn one_way(&self) -> Option<Vec3> {
+        self.one_way
+    }
     /// The pose (frame origin, orientation) a kinematic body was told to reach at the end
     /// of the next step, until that step takes it (see `World::set_kinematic_target`).
     pub fn kinematic_target(&self) -> Option<(Vec3, Quat)> {
@@ -327,6 +353,15 @@ impl Body {
     /// Collision layers (group) and the layers it collides with (mask).
     pub fn collision_filter(&self) -> (u32, u32) {
         (self.filter.group, self.filter.mask)
+    }
+    /// The filter of the body's broad-phase proxy: its own, or for a sensor one that
+    /// pairs with nothing (sensors find their overlaps themselves).
+    pub(crate) fn proxy_filter(&self) -> crate::collision::broad_phase::Filter {
+        if self.sensor {
+            crate::collision::broad_phase::Filter::NONE
+        } else {
+            self.filter
+        }
     }
     /// Whether the body is confined to the XY plane.
     pub fn is_planar(&self) -> bool {
@@ -499,6 +534,19 @@ pub(crate) fn check_restitution(x: Real) -> Result<()> {
 /// The rule for `gravity_scale`: finite, at most `MAX_GRAVITY_SCALE` either way.
 pub(crate) fn check_gravity_scale(x: Real) -> Result<()> {
     check::at_most("gravity_scale", x, crate::limits::MAX_GRAVITY_SCALE, "")
+}
+
+/// The rule for `one_way`: a finite, non-zero vector, returned normalised.
+pub(crate) fn check_one_way(n: Vec3) -> Result<Vec3> {
+    check::vec3("one_way", n)?;
+    // Scaled by its largest component first, so that neither a tiny nor a huge vector
+    // under- or overflows its length.
+    let scale = n.abs().max_element();
+    if scale == 0.0 {
+        return Err(Error::invalid("one_way", "must be a non-zero vector"));
+    }
+    let n = n / scale;
+    Ok(n / n.length())
 }
 
 /// Planes are stored with a unit normal so every routine can rely on it.

@@ -82,12 +82,15 @@ fn sweep_of(body: &Body, s: &BodySim) -> Sweep {
     }
 }
 
+/// The contact hooks' word on whether body i may be stopped at body j (dense indices).
+pub(crate) type Allow<'a> = &'a mut dyn FnMut(usize, usize) -> bool;
+
 /// Whether body `i` moved a point farther this step than its own thickness (or is a
 /// bullet). A point at r from the centre moves by at most |Δx| + 2 |r| sin(φ/2) for a turn
 /// φ, and sin(φ/2) is the length of the turn's quaternion's vector part: a plank 1 cm thick
 /// turning about its middle passes its end through a wall while its centre hardly moves.
 fn is_fast(b: &Body, s: &BodySim) -> bool {
-    if b.kind != BodyKind::Dynamic || !b.awake {
+    if b.kind != BodyKind::Dynamic || !b.awake || b.sensor {
         return false;
     }
     let moved = (s.x - s.x0).length_squared();
@@ -128,11 +131,13 @@ fn turn_arc(b: &Body, q0: crate::math::Quat, v: Vec3) -> Real {
 /// and `margin` are the contact slop and margin (m); `joined` the sorted dense pairs a
 /// joint keeps from colliding, which the sweeps pass through as the contacts do (a door
 /// turning on its hinge was stopped by the frame it is hinged to). `fast` is scratch for
-/// the fast bodies' mask.
+/// the fast bodies' mask. `allow` is the contact hooks' word on a dense pair (see
+/// `pipeline/hooks.rs`): a pair the contact filter refuses, or whose manifolds a hook
+/// emptied this step (a one-way body passed through), is passed through here too.
 pub(crate) fn sweep_fast_bodies(
     bodies: &[Body],
     (solver_bodies, fast): (&mut SolverBodies, &mut Vec<bool>),
-    (broad, joined): (&BroadPhase, &[(u32, u32)]),
+    (broad, joined, allow): (&BroadPhase, &[(u32, u32)], Allow<'_>),
     (slop, margin): (Real, Real),
 ) {
     fast.clear();
@@ -152,11 +157,15 @@ pub(crate) fn sweep_fast_bodies(
         let body = &bodies[i];
         let sweep = sweep_of(body, &solver_bodies.sims[i]);
         let stop = Stop::Allowance(allowance(body, slop, margin));
-        let Some((hit, with)) = sweeps.first_impact(&solver_bodies.sims, i, &sweep, stop) else {
+        let first = sweeps.first_impact(&solver_bodies.sims, (i, &mut *allow), &sweep, stop);
+        let Some((hit, with)) = first else {
             continue;
         };
         let contact = match with {
-            None if hit.near => sweeps.slide(&mut solver_bodies.sims, i, &sweep, &hit, stop),
+            None if hit.near => {
+                let sims = &mut solver_bodies.sims;
+                sweeps.slide(sims, (i, &mut *allow), &sweep, &hit, stop)
+            }
             _ => {
                 let carry = with.map(|j| sweep_of(&bodies[j], &solver_bodies.sims[j]));
                 place(
@@ -224,7 +233,7 @@ impl Sweeps<'_> {
     fn slide(
         &self,
         sims: &mut [BodySim],
-        i: usize,
+        (i, allow): (usize, Allow<'_>),
         sweep: &Sweep,
         hit: &Impact,
         stop: Stop,
@@ -254,7 +263,7 @@ impl Sweeps<'_> {
             at => at,
         };
         let reached = self
-            .first_impact(sims, i, &along, stop)
+            .first_impact(sims, (i, allow), &along, stop)
             .map_or(1.0, |(second, _)| second.toi.t);
         let sim = &mut sims[i];
         sim.x = from.transform_point(sweep.local_center) + glide * reached;
@@ -267,7 +276,7 @@ impl Sweeps<'_> {
     fn first_impact(
         &self,
         sims: &[BodySim],
-        i: usize,
+        (i, allow): (usize, Allow<'_>),
         sweep: &Sweep,
         stop: Stop,
     ) -> Option<(Impact, Option<usize>)> {
@@ -280,6 +289,7 @@ impl Sweeps<'_> {
             };
             let pair = (i.min(j) as u32, i.max(j) as u32);
             let eligible = j != i
+                && !other.sensor
                 && body.filter.allows(&other.filter)
                 && (other.kind == BodyKind::Static || (body.bullet && !other.bullet))
                 && self.joined.binary_search(&pair).is_err();
@@ -297,6 +307,10 @@ impl Sweeps<'_> {
                     local_center: Vec3::ZERO,
                 }
             };
+            let closing = sweep.translation - path.translation;
+            if !(meets(other, closing) && meets(body, -closing) && allow(i, j)) {
+                return;
+            }
             let limit = first.map_or(1.0, |(f, _)| f.toi.t);
             if let Some(hit) = sweep_shapes(&body.shape, sweep, &other.shape, &path, stop, limit) {
                 first = Some((hit, moving.then_some(j)));
@@ -304,6 +318,15 @@ impl Sweeps<'_> {
         });
         first
     }
+}
+
+/// Whether a body moving by `closing` relative to one-way body `p` comes at it from the
+/// side of its normal (against the normal), and so may be stopped by it: a body moving
+/// up through a platform, or along it, passes (see `pipeline/hooks.rs`). Any body that
+/// is not one-way stops everything.
+fn meets(p: &Body, closing: Vec3) -> bool {
+    p.one_way
+        .is_none_or(|n| closing.dot(p.orientation * n) < 0.0)
 }
 
 /// The region body `b` sweeps through: its boxes at both ends, widened by how far a point

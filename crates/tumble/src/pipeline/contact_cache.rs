@@ -3,7 +3,7 @@
 //! impulses it found then (warm starting).
 
 use crate::collision::broad_phase::{BroadPhase, Crowding};
-use crate::collision::contact::{Basis, Key, REUSE_DISTANCE};
+use crate::collision::contact::{Basis, Gate, Key, REUSE_DISTANCE};
 pub use crate::collision::contact::{Contact, ContactEvent, ContactEventKind};
 use crate::collision::geometry::{Aabb, Pose};
 use crate::collision::narrow_phase::{collide, Manifold};
@@ -294,9 +294,12 @@ fn reuse_previous(
     margin: Real,
     contacts: &mut Vec<Contact>,
 ) -> bool {
+    // A manifold a hook took points out of is computed afresh: its basis describes the
+    // whole manifold, and the hook decides again on the new one.
     let Some(c) = old.find((ids[a], ids[b], 0, 0)).filter(|c| {
-        c.basis
-            .holds(&Basis::relative(pa, pb), REUSE_DISTANCE * margin)
+        !c.edited
+            && c.basis
+                .holds(&Basis::relative(pa, pb), REUSE_DISTANCE * margin)
     }) else {
         return false;
     };
@@ -402,6 +405,9 @@ fn push_new(
             index_a: a as u32,
             index_b: b as u32,
             basis: Basis::of(manifold, pa, pb),
+            new: true,
+            gate: Gate::New,
+            edited: false,
         });
         let contact = contacts.last_mut().expect("just pushed");
         warm_start(contact, old, (pa, pb));
@@ -419,17 +425,20 @@ impl ContactCache {
     /// dynamic bodies, each already overlapping `limits.per_body` others or sunk into half
     /// as many (see `ContactLimits`); and the update stops, with
     /// [`ContactCache::overflowed`] set, on reaching `limits.per_step` manifolds.
-    pub fn update(
+    /// `filter` takes out the pairs the contact filter refuses (see `pipeline/hooks.rs`).
+    /// The events are found by [`ContactCache::find_events`], once the hooks have acted.
+    pub(crate) fn update<F: FnOnce(&mut Vec<(u32, u32)>)>(
         &mut self,
         broad: &mut BroadPhase,
         bodies: &[Body],
         ids: &[BodyId],
         (margin, step): (Real, (Real, Real)),
-        joined: &[(u32, u32)],
+        (joined, filter): (&[(u32, u32)], F),
         (limits, par): (&ContactLimits, Par),
     ) {
         broad.set_crowding(crowding(limits, margin));
         broad.pairs(&mut self.pairs);
+        filter(&mut self.pairs);
         let statics = bodies.iter().filter(|b| b.kind == BodyKind::Static).count();
         std::mem::swap(&mut self.contacts, &mut self.previous);
         self.index_previous();
@@ -449,7 +458,6 @@ impl ContactCache {
         if !parallel {
             self.update_in_order(&world, broad, joined, limits);
         }
-        self.find_events();
     }
 
     /// The pairs one after another, counting each body's overlaps for the crowding caps
@@ -618,7 +626,9 @@ impl ContactCache {
         &self.events
     }
 
-    fn find_events(&mut self) {
+    /// Finds the begin and end events of the last update: the pairs with points now and
+    /// not before, and the other way round.
+    pub(crate) fn find_events(&mut self) {
         std::mem::swap(&mut self.touching, &mut self.touching_before);
         self.touching.clear();
         self.touching.extend(
@@ -721,7 +731,8 @@ fn drop_covered_points(
         broad.query_static_aabb_with(&Aabb::new(probe, probe), stack, |user| {
             let k = user as usize;
             if !inside && k != fixed {
-                let covers = |o: &&Body| o.kind == BodyKind::Static && o.filter.allows(&filter);
+                let covers =
+                    |o: &&Body| o.kind == BodyKind::Static && !o.sensor && o.filter.allows(&filter);
                 if let Some(other) = bodies.get(k).filter(covers) {
                     // Within a tenth of the step of the other body counts: the normal can be
                     // tilted by a hair and lift the probe off a face level with this one.
@@ -825,6 +836,7 @@ fn keep_previous(
         out.push(Contact {
             index_a: a as u32,
             index_b: b as u32,
+            new: false,
             ..*c
         });
     }
@@ -841,7 +853,7 @@ fn warm_start(contact: &mut Contact, previous: &Sorted<'_>, poses: (&Pose, &Pose
         p.anchor_b = poses.1.inverse_transform_point(mid);
         p.anchored = true;
     };
-    let Some(old) = previous.find(contact.key()).map(|c| &c.manifold) else {
+    let Some(old) = previous.find(contact.key()) else {
         contact
             .manifold
             .points_mut()
@@ -849,6 +861,8 @@ fn warm_start(contact: &mut Contact, previous: &Sorted<'_>, poses: (&Pose, &Pose
             .for_each(anchor_here);
         return;
     };
+    (contact.new, contact.gate) = (false, old.gate);
+    let old = &old.manifold;
     contact.manifold.angular_impulse = old.angular_impulse;
     contact.manifold.overlap = old.overlap;
     contact.manifold.fine = old.fine;

@@ -7,6 +7,8 @@
 //!                shape casts and overlaps (query.rs); World::step, its stages and the
 //!                step context (step.rs)
 //! contact_cache  persistent manifolds: broad and narrow phase into warm-started contacts
+//! hooks          the contact filter and modifier, one-way bodies
+//! sensors        sensors' overlaps and their begin/end events
 //! speculative    speculative contacts the step will not reach (no ghost collisions)
 //! ccd            sweeps of fast bodies back to their time of impact
 //! diagnostics    energies, momenta, state hash
@@ -17,5 +19,7 @@ pub mod analysis;
 pub(crate) mod ccd;
 pub mod contact_cache;
 pub mod diagnostics;
+pub mod hooks;
+pub mod sensors;
 pub(crate) mod speculative;
 pub mod world;

@@ -111,6 +111,10 @@ impl Default for Filter {
 }
 
 impl Filter {
+    /// The filter of a proxy that pairs with nothing (a sensor's: sensors find their
+    /// overlaps by queries of their own).
+    pub const NONE: Filter = Filter { group: 0, mask: 0 };
+
     /// Whether the two filters let their proxies pair.
     pub fn allows(&self, other: &Filter) -> bool {
         self.group & other.mask != 0 && other.group & self.mask != 0

@@ -32,10 +32,14 @@ impl BroadPhase {
 
     /// Calls `f(user)` for every proxy whose enlarged box overlaps `aabb` (static proxies
     /// first).
-    pub fn query_aabb(&self, aabb: &Aabb, mut f: impl FnMut(u32)) {
-        let mut stack = Vec::new();
+    pub fn query_aabb(&self, aabb: &Aabb, f: impl FnMut(u32)) {
+        self.query_aabb_with(aabb, &mut Vec::new(), f);
+    }
+
+    /// [`BroadPhase::query_aabb`] with the caller's scratch `stack`.
+    pub fn query_aabb_with(&self, aabb: &Aabb, stack: &mut Vec<u32>, mut f: impl FnMut(u32)) {
         for tree in &self.trees {
-            tree.query(aabb, &mut stack, |id| f(self.proxies[id as usize].user));
+            tree.query(aabb, stack, |id| f(self.proxies[id as usize].user));
         }
     }
 

@@ -176,6 +176,9 @@ pub(crate) struct PairData {
     pub bodies: (usize, usize),
     /// The pair's friction and restitution.
     pub material: (Real, Real),
+    /// The surface velocity friction drives body b's points to relative to a's (m/s,
+    /// world frame; see `ContactMaterial::surface_velocity`).
+    pub surface: Vec3,
     /// The pair's rolling resistance and torsional friction (`super::angular::combine`).
     pub angular: (Real, Real),
     /// The bodies' frames at the start of the step (for the friction anchors).
@@ -336,6 +339,14 @@ impl ContactConstraint {
                 round: round_arms(m, pair.round),
                 // Read only by stiffened passes, after `stiffen` has set it.
                 impulse_scale: 0.0,
+                // Exact zeros without a surface velocity (t·0 may be −0, and x − (−0)
+                // turns a −0 into +0): x − 0 is x, bit for bit.
+                surface: if pair.surface == Vec3::ZERO {
+                    [0.0; 2]
+                } else {
+                    tangents.map(|t| t.dot(pair.surface))
+                },
+                anchor: if pair.surface == Vec3::ZERO { 1.0 } else { 0.0 },
             },
             moves: (sa.moves, sb.moves),
             restitution,

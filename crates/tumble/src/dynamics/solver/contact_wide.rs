@@ -218,6 +218,11 @@ impl ContactLanes {
                     Lanes::from_fn(|l| lane(l).round()[1]),
                 ],
                 impulse_scale: Lanes::from_fn(|l| lane(l).frame.impulse_scale),
+                surface: [
+                    Lanes::from_fn(|l| lane(l).frame.surface[0]),
+                    Lanes::from_fn(|l| lane(l).frame.surface[1]),
+                ],
+                anchor: Lanes::from_fn(|l| lane(l).frame.anchor),
             },
             round: cs.iter().any(|c| c.has_round()),
             slot0,

@@ -42,7 +42,7 @@ pub(crate) use body::{BodySim, BodyState, SolverBodies};
 use contact::{BiasRule, ContactConstraint, PairData, Points};
 use joint::{JointConstraint, JointPass};
 
-use crate::collision::contact::Contact;
+use crate::collision::contact::{Contact, ContactMaterial};
 use crate::collision::narrow_phase::Overlap;
 use crate::dynamics::body::Motion;
 use crate::dynamics::body::{Body, BodyKind};
@@ -64,6 +64,9 @@ pub(crate) struct StepInput<'a, 'b> {
     pub scales: &'a Scales,
     /// Contacts to leave out this step (speculative ones the bodies will not reach).
     pub ghosts: &'a [bool],
+    /// Per contact, the material the contact modifier left; empty without one (each pair
+    /// then has its bodies' own).
+    pub materials: &'a [ContactMaterial],
     /// The world's joints, and the dense indices of each one's bodies (`None`: the world
     /// or a broken joint's absent partner).
     pub joints: &'a mut [Joint],
@@ -128,7 +131,7 @@ impl Solver {
         let gravity = input.system.gravity;
         self.prepare(
             (bodies, world_bodies),
-            contacts,
+            (contacts, input.materials),
             input.ghosts,
             (
                 input.scales.linear_slop,
@@ -452,7 +455,7 @@ impl Solver {
     fn prepare(
         &mut self,
         (bodies, world_bodies): (&SolverBodies, &[Body]),
-        contacts: &[Contact],
+        (contacts, materials): (&[Contact], &[ContactMaterial]),
         ghosts: &[bool],
         (slop, gravity, allow, spring): (Real, Vec3, overlap::Allowance, LoadSpring),
     ) {
@@ -473,8 +476,14 @@ impl Solver {
             let c = &contacts[i];
             let (a, b) = (c.index_a as usize, c.index_b as usize);
             let (sa, sb) = (&bodies.sims[a], &bodies.sims[b]);
-            let friction = (sa.friction * sb.friction).sqrt();
-            let restitution = sa.restitution.max(sb.restitution);
+            let (friction, restitution, surface) = match materials.get(i) {
+                Some(m) => (m.friction, m.restitution, m.surface_velocity),
+                None => (
+                    (sa.friction * sb.friction).sqrt(),
+                    sa.restitution.max(sb.restitution),
+                    Vec3::ZERO,
+                ),
+            };
             let pose = |k: usize| {
                 let s = &bodies.sims[k];
                 crate::collision::geometry::Pose::new(s.x - s.q * s.local_center, s.q)
@@ -482,6 +491,7 @@ impl Solver {
             let pair = PairData {
                 bodies: (a, b),
                 material: (friction, restitution),
+                surface,
                 angular: angular::combine(sa, sb),
                 poses: (pose(a), pose(b)),
                 round: (

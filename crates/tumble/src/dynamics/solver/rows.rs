@@ -94,6 +94,13 @@ pub(crate) struct Frame<W: Wide = Real> {
     /// minus this: the contacts' spring, stiffened for a heavy load (see
     /// `softness::LoadSpring`).
     pub impulse_scale: W,
+    /// The relative tangential velocity friction drives toward, along each tangent (m/s):
+    /// the contact modifier's surface velocity (a conveyor belt); zero otherwise, and
+    /// subtracting a zero changes no bit.
+    pub surface: [W; 2],
+    /// 1 where the friction anchors pull, 0 for a manifold with a surface velocity, whose
+    /// anchors would pull it back against the belt (times 1 changes no bit).
+    pub anchor: W,
 }
 
 /// Which lanes a point's updates reach (see the module docs).
@@ -466,14 +473,14 @@ fn solve_friction<W: Wide, const BIAS: bool>(
         return;
     }
     let vt = [
-        p.tangent[0].velocity(f.tangents[0], p.ra, p.rb, s),
-        p.tangent[1].velocity(f.tangents[1], p.ra, p.rb, s),
+        p.tangent[0].velocity(f.tangents[0], p.ra, p.rb, s) - f.surface[0],
+        p.tangent[1].velocity(f.tangents[1], p.ra, p.rb, s) - f.surface[1],
     ];
     let want = match slip {
         // Written out rather than `[0, 1].map`, which the compiler left as a call.
         Some(slip) if BIAS => [
-            anchored_want(p, 0, vt[0], slip[0], rule),
-            anchored_want(p, 1, vt[1], slip[1], rule),
+            anchored_want(p, 0, vt[0], (slip[0], f.anchor), rule),
+            anchored_want(p, 1, vt[1], (slip[1], f.anchor), rule),
         ],
         _ => [
             ti[0] - p.tangent[0].mass * vt[0],
@@ -492,11 +499,17 @@ fn solve_friction<W: Wide, const BIAS: bool>(
 }
 
 /// The biased pass's friction impulse along tangent `k` before the cone: the anchors'
-/// spring plus stopping the slip.
+/// spring (`anchor`: 1 where it pulls, 0 where not) plus stopping the slip.
 #[inline(always)]
-fn anchored_want<W: Wide>(p: &Point<W>, k: usize, vt: W, slip: Moved<W>, rule: &BiasRule) -> W {
+fn anchored_want<W: Wide>(
+    p: &Point<W>,
+    k: usize,
+    vt: W,
+    (slip, anchor): (Moved<W>, W),
+    rule: &BiasRule,
+) -> W {
     let soft = rule.softness;
-    let rate = W::splat(ANCHOR_STIFFNESS * soft.bias_rate);
+    let rate = W::splat(ANCHOR_STIFFNESS * soft.bias_rate) * anchor;
     let (lo, hi) = (W::splat(-rule.max_push), W::splat(rule.max_push));
     let gap = slip.gap(p.anchor_gap[k], p.ra, p.rb, p.tangent_lever[k]);
     let bias = (rate * gap).clamp(lo, hi);

@@ -36,8 +36,10 @@ impl World {
             body.shape.aabb(&body.pose()),
             store.list.len() as u32,
             kind,
-            body.filter,
+            body.proxy_filter(),
         );
+        self.hooks.one_way_bodies += usize::from(body.one_way.is_some());
+        self.sensors.sensor_bodies += usize::from(body.sensor);
         self.collision.proxies.push(proxy);
         store.list.push(body);
         self.memory.push();
@@ -53,7 +55,10 @@ impl World {
         // Whatever rested on it must notice it is gone.
         self.wake_around(dense);
         // Keep creation order (outputs list bodies in it); removal is rare.
-        self.bodies.list.remove(dense);
+        let body = self.bodies.list.remove(dense);
+        self.hooks.one_way_bodies -= usize::from(body.one_way.is_some());
+        self.sensors.sensor_bodies -= usize::from(body.sensor);
+        self.sensors.forget(id, self.clock.time);
         self.bodies.handles.remove(id);
         self.memory.remove(dense);
         let c = &mut self.collision;

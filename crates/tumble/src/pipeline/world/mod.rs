@@ -13,14 +13,18 @@
 //! | `collision` | the broad phase (trees, fat boxes, pair set), one proxy per body, the contact cache (manifolds with warm starts and friction anchors, events) |
 //! | `islands`   | the sleep tag counter (islands' membership lives in the bodies' tags)  |
 //! | `memory`    | the integrator's memory (Störmer–Verlet's previous positions)          |
+//! | `sensors`   | sensors' overlapping pairs, the last step's sensor events, end events of edits since |
+//! | `hooks`     | the contact filter and modifier (code: re-attached, not saved), the filter's verdicts, the count of one-way bodies |
 //!
 //! `scratch` ([`StepContext`]) is what one step builds and throws away; it is kept only so
 //! that stepping allocates nothing, and nothing in it is read before a step writes it.
 //! The step itself is in `step.rs`; body, force and joint edits in `bodies.rs`,
-//! `forces.rs` and `joints.rs`; queries in `query.rs`.
+//! `forces.rs` and `joints.rs`; queries in `query.rs`; contact hooks and sensor reports in
+//! `contact_hooks.rs`.
 
 mod bodies;
 pub mod bulk;
+mod contact_hooks;
 mod forces;
 mod invariant;
 mod joint_coords;
@@ -44,6 +48,8 @@ use crate::limits::{ContactLimits, SpeedLimits, MAX_ACCELERATION};
 use crate::math::{Real, Vec3};
 use crate::pipeline::contact_cache::ContactCache;
 use crate::pipeline::diagnostics::{self, Diagnostics};
+use crate::pipeline::hooks::{Hooks, OneWayRule};
+use crate::pipeline::sensors::SensorStore;
 use crate::threads::Workers;
 use step::StepContext;
 
@@ -211,6 +217,11 @@ pub struct World {
     /// The islands' tag counter (see `dynamics/island.rs`).
     pub(crate) sleep_tag: u32,
     pub(crate) memory: IntegratorMemory,
+    /// Sensors' overlaps and events (see `pipeline/sensors.rs`).
+    pub(crate) sensors: SensorStore,
+    /// The contact filter and modifier (code: not saved, re-attached) and what they hand
+    /// to the step (see `pipeline/hooks.rs`).
+    pub(crate) hooks: Hooks,
     /// Scratch of one step (see `step.rs`): not part of the world's state.
     pub(crate) scratch: StepContext,
     /// The threads steps run on (a setting, not state: results do not depend on it).
@@ -279,6 +290,8 @@ impl World {
             },
             sleep_tag: 0,
             memory: IntegratorMemory::default(),
+            sensors: SensorStore::default(),
+            hooks: Hooks::default(),
             scratch: StepContext::default(),
             workers: Workers::new(def.threads.unwrap_or_else(crate::threads::default_threads)),
         }
@@ -452,7 +465,8 @@ impl World {
     }
 
     /// Runs the broad and narrow phases on the current state and returns every contact
-    /// manifold; points keep last update's impulses where their feature ids match. At most
+    /// manifold; points keep last update's impulses where their feature ids match. The
+    /// contact filter, one-way bodies and the contact modifier act as in a step. At most
     /// [`ContactLimits::per_step`] are returned (a step that needs more fails).
     pub fn update_contacts(&mut self) -> &[Contact] {
         let mut workers = std::mem::take(&mut self.workers);
@@ -466,17 +480,29 @@ impl World {
 
     /// The contact update before a step of `dt`: pairs that can close more than the
     /// contact margin within it get a margin as wide as that.
+    /// The hooks (see `pipeline/hooks.rs`) act between the narrow phase and the events.
     pub(crate) fn update_contacts_for(&mut self, dt: Real) -> &[Contact] {
         let c = &mut self.collision;
         let step = (dt, self.settings.gravity.length() * dt);
+        let (bodies, ids) = (&self.bodies.list, self.bodies.handles.ids());
+        let hooks = &mut self.hooks;
         c.contacts.update(
             &mut c.broad_phase,
-            &self.bodies.list,
-            self.bodies.ids(),
+            bodies,
+            ids,
             (self.settings.tolerances.contact_margin, step),
-            &self.joints.joined_pairs,
+            (&self.joints.joined_pairs, |pairs: &mut Vec<(u32, u32)>| {
+                hooks.filter_pairs(pairs, bodies, ids);
+            }),
             (&self.settings.contacts, self.scratch.par),
         );
+        let rule = OneWayRule {
+            kick: self.settings.gravity * dt,
+            speed: self.settings.tolerances.sleep_speed,
+        };
+        let max_speed = self.settings.limits.max_speed;
+        hooks.apply(c.contacts.contacts_mut(), bodies, &rule, max_speed);
+        c.contacts.find_events();
         c.contacts.contacts()
     }
 

@@ -1,5 +1,6 @@
 //! Run-time edits of a body's properties: friction, restitution, collision filter,
-//! damping, gravity scale, and a kinematic body's target pose. Each checks its value with
+//! sensor flag, one-way normal, damping, gravity scale, and a kinematic body's target
+//! pose. Each checks its value with
 //! the rule `World::create_body` applies to the same field of `BodyDef` (the same message,
 //! so a scene file, Rust and Python refuse a value alike), changes nothing when it fails,
 //! and wakes the body and what touches it: a resting pile must notice that its friction
@@ -7,7 +8,9 @@
 
 use crate::collision::broad_phase::Filter;
 use crate::dynamics::body::BodyKind;
-use crate::dynamics::body::{check_friction, check_gravity_scale, check_restitution, Body};
+use crate::dynamics::body::{
+    check_friction, check_gravity_scale, check_one_way, check_restitution, Body,
+};
 use crate::error::{check, Error, Result};
 use crate::id::BodyId;
 use crate::limits::MAX_COORDINATE;
@@ -46,11 +49,44 @@ impl World {
     pub fn set_collision_filter(&mut self, id: BodyId, group: u32, mask: u32) -> Result<()> {
         let filter = Filter { group, mask };
         self.edit_property(id, |b| b.filter = filter)?;
-        // `edit_property` found the body, so its dense index exists.
+        self.refilter(id);
+        Ok(())
+    }
+
+    /// Hands body `id`'s proxy filter to the broad phase, which searches its pairs again
+    /// at the next step.
+    fn refilter(&mut self, id: BodyId) {
         if let Some(i) = self.dense(id) {
             let c = &mut self.collision;
-            c.broad_phase.set_filter(c.proxies[i], filter);
+            c.broad_phase
+                .set_filter(c.proxies[i], self.bodies.list[i].proxy_filter());
         }
+    }
+
+    /// Makes a body a sensor or an ordinary body (see `BodyDef::sensor`), from the next
+    /// step on. Its overlaps as a sensor, or with sensors, end at once (their end events
+    /// come first among the next step's sensor events); its contacts end at the next step.
+    pub fn set_sensor(&mut self, id: BodyId, sensor: bool) -> Result<()> {
+        let was = self.body(id)?.sensor;
+        self.edit_property(id, |b| b.sensor = sensor)?;
+        if was != sensor {
+            self.sensors.forget(id, self.clock.time);
+            self.sensors.sensor_bodies =
+                self.sensors.sensor_bodies + usize::from(sensor) - usize::from(was);
+            self.refilter(id);
+        }
+        Ok(())
+    }
+
+    /// Makes a body one-way with `normal` (body frame; finite, non-zero, normalised), or
+    /// an ordinary body with `None` (see `BodyDef::one_way`). Manifolds with it are decided
+    /// afresh as they begin.
+    pub fn set_one_way(&mut self, id: BodyId, normal: Option<Vec3>) -> Result<()> {
+        let normal = normal.map(check_one_way).transpose()?;
+        let was = self.body(id)?.one_way.is_some();
+        self.edit_property(id, |b| b.one_way = normal)?;
+        self.hooks.one_way_bodies =
+            self.hooks.one_way_bodies + usize::from(normal.is_some()) - usize::from(was);
         Ok(())
     }
 

@@ -23,6 +23,7 @@
 //!                                                          returns the error
 //! scatter              context                             bodies' state, broad-phase proxies
 //! update_sleep         bodies, contacts, joint links       sleep timers, awake flags, tags
+//! update_sensors       bodies, broad phase, contact filter sensors' overlaps and events
 //! ```
 //!
 //! Time has one vocabulary ([`StepTime`]): `dt` is the step, `h` = `dt` / substeps the
@@ -120,6 +121,7 @@ impl World {
         self.update_sleep(&time);
         self.clock.time += dt;
         self.clock.steps += 1;
+        self.update_sensors();
         Ok(())
     }
 
@@ -222,6 +224,7 @@ impl World {
             settings: &self.settings.solver,
             scales: &self.settings.tolerances.scales,
             ghosts: &ctx.ghosts,
+            materials: &self.hooks.materials,
             joints: &mut self.joints.list,
             joint_bodies: &self.joints.links,
             time,
@@ -247,10 +250,17 @@ impl World {
 
     /// Fast bodies go back to their first time of impact (see `pipeline/ccd.rs`).
     fn sweep_fast(&mut self) {
+        let (bodies, ids) = (&self.bodies.list, self.bodies.handles.ids());
+        let hooks = &mut self.hooks;
+        let mut allow = |i: usize, j: usize| hooks.ccd_allows(bodies, ids, i, j);
         crate::pipeline::ccd::sweep_fast_bodies(
-            &self.bodies.list,
+            bodies,
             (&mut self.scratch.bodies, &mut self.scratch.fast),
-            (&self.collision.broad_phase, &self.joints.joined_pairs),
+            (
+                &self.collision.broad_phase,
+                &self.joints.joined_pairs,
+                &mut allow,
+            ),
             (
                 self.settings.tolerances.scales.linear_slop,
                 self.settings.tolerances.contact_margin,
