@@ -95,7 +95,7 @@ impl CharacterController {
     /// part of the displacement), where the slide got `progress` (m) along it: lifted,
     /// slid, dropped, and taken (the landing and its ground) only if it lands on walkable
     /// ground at most `step_height` above its feet and gets a tenth of the way farther
-    /// than the slide.
+    /// than the slide (and than where it started).
     fn step_up(
         &self,
         world: &World,
@@ -115,7 +115,9 @@ impl CharacterController {
         }
         let raised = start + up * rise;
         let moved = self.slide(world, raised, across, &mut Vec::new()).end;
-        if (moved - start).dot(across / length) <= progress + 0.1 * length {
+        // The slide may have moved it back (out of a skin it was inside): a step must
+        // get a tenth of the way forward besides.
+        if (moved - start).dot(across / length) <= progress.max(0.0) + 0.1 * length {
             return None;
         }
         let drop = up * (rise + skin);
@@ -218,7 +220,9 @@ impl CharacterController {
 }
 
 /// Notes in `blocked` how far each dynamic body's steep surface pushed the move back in
-/// this pass (the sum over its planes of push × normal), keeping each body's largest.
+/// this pass (the sum over its planes of push × normal, less the part of each push that
+/// restores the skin), for the bodies not noted in an earlier pass: later passes solve
+/// again for the whole rest of the displacement, the part already held back included.
 /// Walkable surfaces are not pushed: standing on a body presses on it only through the
 /// world's own contacts, which the character is not part of.
 fn note_blocked(
@@ -233,23 +237,23 @@ fn note_blocked(
         if t.normal.dot(up) >= cos_slope {
             continue;
         }
+        // Less what only restores the skin: that is the character's own correction,
+        // not a move the body stood in the way of.
         let push: Vec3 = planes
             .iter()
             .filter(|p| p.touch == i)
-            .map(|p| p.normal * p.push)
+            .map(|p| p.normal * (p.push - (-p.gap).max(0.0)).max(0.0))
             .sum();
         if push == Vec3::ZERO {
             continue;
         }
-        match blocked.iter_mut().find(|b| b.body == t.body) {
-            Some(b) if b.push.length() >= push.length() => {}
-            Some(b) => (b.push, b.point) = (push, t.point),
-            None => blocked.push(Blocked {
+        if blocked.iter().all(|b| b.body != t.body) {
+            blocked.push(Blocked {
                 body: t.body,
                 mass,
                 push,
                 point: t.point,
-            }),
+            });
         }
     }
 }
