@@ -81,7 +81,7 @@ pub(super) fn planes(touches: &[Touch], up: Vec3, cos_slope: Real, skin: Real) -
             touch: i,
             steep,
         };
-        let wall = if rise > 1e-3 && rise < cos_slope {
+        let wall = if rise > 0.0 && rise < cos_slope {
             (t.normal - up * rise).normalize_or_zero()
         } else {
             Vec3::ZERO
@@ -90,13 +90,16 @@ pub(super) fn planes(touches: &[Touch], up: Vec3, cos_slope: Real, skin: Real) -
             add(plane);
             continue;
         }
-        // An upward slope too steep to walk (see the module header).
+        // An upward slope too steep to walk (see the module header). The wall first: a
+        // face a hair off vertical (a crate tipped by a push) gives two planes that are
+        // one, and the one kept must be the wall, or each push along the face lifts the
+        // character by its tilt, a few microns a step, without end.
         add(Plane {
-            gap: gap.max(0.0),
+            normal: wall,
             ..plane
         });
         add(Plane {
-            normal: wall,
+            gap: gap.max(0.0),
             ..plane
         });
     }
