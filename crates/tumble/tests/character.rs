@@ -199,7 +199,7 @@ fn slopes_over_the_limit_are_refused() {
         let sphere = Vec3::new(c.position().x, r + SKIN, 0.0);
         let gap = n.dot(sphere - Vec3::new(1.0, 0.0, 0.0)) - r;
         assert!(
-            gap >= 0.4 * SKIN && gap <= 1.1 * SKIN,
+            (0.4 * SKIN..=1.1 * SKIN).contains(&gap),
             "r {r} dt {dt}: gap {gap}"
         );
         assert!(c.on_ground(), "r {r} dt {dt}: stands on the flat ground");
@@ -254,7 +254,7 @@ fn steps_under_the_step_height_are_climbed_and_higher_ones_refused() {
                     // face, or its top edge when c is above it (a step lower than r).
                     let c = p - Vec3::new(0.0, 0.6, 0.0);
                     let gap = (c - Vec3::new(face, c.y.min(h), 0.0)).length() - r;
-                    assert!(gap >= 0.4 * SKIN && gap <= 1.1 * SKIN, "{case}");
+                    assert!((0.4 * SKIN..=1.1 * SKIN).contains(&gap), "{case}");
                 }
             }
         }

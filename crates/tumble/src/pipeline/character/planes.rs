@@ -12,7 +12,7 @@
 //! In three dimensions at most three independent planes are met at the solution, so it
 //! is found exactly by trying every set of one, two or three planes as the met ones
 //! (their λ from the 1×1 to 3×3 Gram system), keeping the nearest δ whose pushes are
-//! >= 0 and which breaks no plane. Box2D's and Box3D's movers solve their planes by
+//! all at least 0 and which breaks no plane. Box2D's and Box3D's movers solve their planes by
 //! Hildreth's method (projected Gauss–Seidel on the pushes) instead; it converges at a
 //! rate of cos² of the angle between two planes met together, which for a steep edge's
 //! tilted plane and its wall (below, a few degrees apart) left the move centimetres off
@@ -134,8 +134,17 @@ fn allows(planes: &[Plane], delta: Vec3, tolerance: Real) -> bool {
 /// no set gives pushes >= 0 and a move every plane allows (the planes leave no room: a
 /// capsule squeezed between surfaces closer than its width).
 fn exact(desired: Vec3, planes: &mut [Plane], tolerance: Real) -> Option<Vec3> {
+    /// A set of planes taken as the ones met, and the move it gives.
+    #[derive(Clone, Copy)]
+    struct Met {
+        cost: Real,
+        delta: Vec3,
+        set: [usize; 3],
+        lambda: [Real; 3],
+        size: usize,
+    }
     let n = planes.len();
-    let mut best: Option<(Real, Vec3, [usize; 3], [Real; 3], usize)> = None;
+    let mut best: Option<Met> = None;
     let mut consider = |set: [usize; 3], size: usize| {
         let Some(lambda) = pushes(desired, planes, &set[..size]) else {
             return;
@@ -148,8 +157,14 @@ fn exact(desired: Vec3, planes: &mut [Plane], tolerance: Real) -> Option<Vec3> {
                 .map(|k| planes[set[k]].normal * lambda[k])
                 .sum::<Vec3>();
         let cost = (delta - desired).length_squared();
-        if best.is_none_or(|b| cost < b.0) && allows(planes, delta, tolerance) {
-            best = Some((cost, delta, set, lambda, size));
+        if best.is_none_or(|b| cost < b.cost) && allows(planes, delta, tolerance) {
+            best = Some(Met {
+                cost,
+                delta,
+                set,
+                lambda,
+                size,
+            });
         }
     };
     for i in 0..n {
@@ -161,11 +176,11 @@ fn exact(desired: Vec3, planes: &mut [Plane], tolerance: Real) -> Option<Vec3> {
             }
         }
     }
-    let (_, delta, set, lambda, size) = best?;
-    for k in 0..size {
-        planes[set[k]].push = lambda[k];
+    let met = best?;
+    for k in 0..met.size {
+        planes[met.set[k]].push = met.lambda[k];
     }
-    Some(delta)
+    Some(met.delta)
 }
 
 /// The pushes λ that put δ₀ + Σ λ_k n_k exactly on the planes of `set`: the Gram system
