@@ -67,10 +67,11 @@ impl Walker {
     }
 
     /// Moves the character over the world's next step of `dt` (s), before that step: the
-    /// path's velocity at the world's time plus the fall (the world's gravity accumulated
+    /// path's velocity at the step's middle (so a step belongs to one leg whatever the
+    /// rounding of the time it starts at) plus the fall (the world's gravity accumulated
     /// while it is in the air), then its body's kinematic target set where it went.
     pub fn advance(&mut self, world: &mut World, dt: Real) -> tumble::Result<()> {
-        let velocity = self.velocity_at(world.time());
+        let velocity = self.velocity_at(world.time() + 0.5 * dt);
         if self.controller.on_ground() {
             self.fall = Vec3::ZERO;
         } else {
