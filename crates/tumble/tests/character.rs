@@ -874,3 +874,47 @@ fn moves_are_deterministic() {
     };
     assert_eq!(run(), run());
 }
+
+/// A character created 10 cm into a wall is put back out by its first move, even one of
+/// zero displacement: to a skin from the wall (to 1e-6 m: the plane solver's push of an
+/// overlap is exact), still standing on the floor. Squeezed between two walls closer than
+/// its width, it stays finite and inside the gap's ends (the planes leave no room; the
+/// fallback solver and the sweep keep it from being thrown out through a wall).
+#[test]
+fn overlaps_are_pushed_out_and_a_squeeze_is_survived() {
+    for r in [0.2, 0.3, 0.45] {
+        let mut w = flat_world();
+        fixed_box(
+            &mut w,
+            Vec3::new(1.5, 1.0, 0.0),
+            Vec3::new(0.5, 1.0, 3.0),
+            Quat::IDENTITY,
+        );
+        let def = CharacterDef {
+            radius: r,
+            ..Default::default()
+        };
+        let mut c = standing(&w, 1.0 - r + 0.1, def);
+        c.move_by(&mut w, Vec3::ZERO, 1.0 / 60.0).unwrap();
+        let gap = 1.0 - (c.position().x + r);
+        assert!((gap - SKIN).abs() < tol(1e-6, 1e-4), "r {r}: gap {gap}");
+        assert!(c.on_ground() && (c.position().y - (r + 0.6 + SKIN)).abs() < 1e-6);
+    }
+    let mut w = flat_world();
+    for x in [-0.75, 0.75] {
+        fixed_box(
+            &mut w,
+            Vec3::new(x, 1.0, 0.0),
+            Vec3::new(0.5, 1.0, 3.0),
+            Quat::IDENTITY,
+        );
+    }
+    let mut c = standing(&w, 0.0, CharacterDef::default());
+    let mut walker = Walker::new();
+    for k in 0..120 {
+        let v = Vec3::new(if k % 2 == 0 { 3.0 } else { -3.0 }, 0.0, 1.0);
+        walker.step(&mut c, &mut w, v, 1.0 / 60.0);
+        let p = c.position();
+        assert!(p.is_finite() && p.x.abs() < 0.25, "{p}");
+    }
+}
