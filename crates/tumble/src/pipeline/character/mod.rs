@@ -34,12 +34,14 @@
 //! 3. **Ground**: the most upward-facing walkable surface within two skins below it;
 //!    a steep contact counts when it is the edge of a walkable face (a step's nose),
 //!    found by a short ray down just past the edge.
-//! 4. **Snap**: when it stood on the ground before, has none now and was not asked to
-//!    rise, it is swept down by up to `snap_distance`, and kept there if it lands on
-//!    walkable ground: walking down a slope or a stair keeps it on the ground.
-//! 5. **Push**: each dynamic body whose steep face held the move back by p (m) gets the
-//!    impulse m·p/dt along the face's inward normal (what makes it move off at the speed
-//!    it blocked), at most `max_push_force · dt`.
+//! 4. **Snap**: unless it was asked to rise, when it stood on the ground before and has
+//!    none now, or its ground is more than 1.1 skins below it, it is swept down by up to
+//!    `snap_distance` and kept there if it lands on walkable ground: walking down a slope
+//!    or a stair keeps it on the ground, a skin above it.
+//! 5. **Push**: each dynamic body whose steep face held the move back by p (m, not
+//!    counting the character's own correction back out to its skin) gets the impulse
+//!    m·p/dt along the face's inward normal (what makes it move off at the speed it
+//!    blocked), at most `max_push_force · dt`.
 
 mod planes;
 mod surface;
