@@ -201,7 +201,7 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
     }
     let c = check(args, &scene)?;
     let sink = Sink::create(c.target.clone(), &c.output)?;
-    let (snapshots, stopped) = simulate(&mut scene.world, args, &c)?;
+    let (snapshots, stopped) = simulate(&mut scene, args, &c)?;
     let colours: Vec<Option<Rgb>> = scene.body_colors.iter().map(|c| c.map(Rgb)).collect();
     let (camera, scale) = camera(&scene.world, &colours, &snapshots, args, &c);
     let model = Model::new(&scene.world, &colours, scale / 12.0);
@@ -233,14 +233,14 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
 /// the latest (the last good state, if a step fails). The failure of a step, if any,
 /// comes second.
 fn simulate(
-    world: &mut tumble::World,
+    scene: &mut tumble_scene::Scene,
     args: &RenderArgs,
     c: &Checked,
 ) -> Result<(Vec<Snapshot>, Option<Failure>), Failure> {
     let mut progress = Progress::new(c.plan.steps, "simulating", args.quiet);
     let mut snapshots = Vec::with_capacity(c.frames.min(MAX_FRAMES) as usize);
     let keep_all = !c.output.single_frame();
-    let stopped = run_frames(world, &c.plan, args.fps, &mut progress, |world, _| {
+    let stopped = run_frames(scene, &c.plan, args.fps, &mut progress, |world, _| {
         if !keep_all {
             snapshots.clear();
         }

@@ -23,8 +23,8 @@ pub const SEED_SCENE: &str = "free_fall";
 pub struct RunArgs {
     /// Scene to run: a built-in name (free_fall, spring, double_spring, dzhanibekov,
     /// planar_spinner, dumbbell, resting, door, cradle, rope_bridge, ragdoll, pyramid,
-    /// pendulum_chain; see `tumble scenes`) or the path of a JSON scene file (format:
-    /// docs/scene-format.md). Built-in names win over files in the current
+    /// pendulum_chain, character_course; see `tumble scenes`) or the path of a JSON scene
+    /// file (format: docs/scene-format.md). Built-in names win over files in the current
     /// directory. Omitted: the seed's free fall, printed as a table against the analytic
     /// solution.
     #[arg(value_name = "SCENE")]
@@ -168,13 +168,7 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
     let plan = plan(args, &scene)?;
     let mut sinks = Sinks::open(args, &scene, &plan)?;
     let mut progress = crate::progress::Progress::new(plan.steps, "running", args.quiet);
-    let stopped = step_all(
-        &mut scene.world,
-        &plan,
-        args.every,
-        &mut sinks,
-        &mut progress,
-    )?;
+    let stopped = step_all(&mut scene, &plan, args.every, &mut sinks, &mut progress)?;
     progress.finish();
     sinks.finish(&scene, &plan, stopped.is_none())?;
     stopped.map_or(Ok(()), Err)
@@ -207,27 +201,28 @@ fn passes(text: &str) -> Result<u32, String> {
     whole_u32(text, 1, MAX_PASSES)
 }
 
-/// Steps the world through `plan`, showing step 0, every `every`-th step and the last to
-/// the sinks. A failed step stops the run: the last good step (the world as it was before
-/// the failed one) is recorded if it was not already, and the step's failure returned.
+/// Steps the scene through `plan` (its character's move, then the world's step),
+/// showing step 0, every `every`-th step and the last to the sinks. A failed step stops
+/// the run: the last good step (the world as it was before the failed one) is recorded
+/// if it was not already, and the step's failure returned.
 fn step_all(
-    world: &mut World,
+    scene: &mut Scene,
     plan: &RunPlan,
     every: u64,
     sinks: &mut Sinks,
     progress: &mut crate::progress::Progress,
 ) -> Result<Option<Failure>, Failure> {
-    sinks.observe(0, 0.0, world, true)?;
+    sinks.observe(0, 0.0, &scene.world, true)?;
     for k in 1..=plan.steps {
-        if let Err(e) = world.step(plan.step_dt(k)) {
+        if let Err(e) = scene.step(plan.step_dt(k)) {
             let good = k - 1;
             if good % every != 0 {
-                sinks.record(plan.time_after(good), world)?;
+                sinks.record(plan.time_after(good), &scene.world)?;
             }
             return Ok(Some(crate::sample::step_failure(k, e)));
         }
         let record = k % every == 0 || k == plan.steps;
-        sinks.observe(k, plan.time_after(k), world, record)?;
+        sinks.observe(k, plan.time_after(k), &scene.world, record)?;
         progress.inc(1);
     }
     Ok(None)

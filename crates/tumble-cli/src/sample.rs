@@ -1,7 +1,7 @@
 //! Running a scene and looking at it at a steady frame rate, for pictures and the viewer.
 
 use tumble::{Real, World};
-use tumble_scene::RunPlan;
+use tumble_scene::{RunPlan, Scene};
 
 use crate::progress::Progress;
 use crate::Failure;
@@ -12,34 +12,35 @@ pub fn frame_count(plan: &RunPlan, fps: Real) -> u64 {
     (plan.end_time * fps + 1e-6).floor() as u64 + 1
 }
 
-/// Steps `world` through `plan`, calling `frame(world, k)` for frame k = 0, 1, ... at the
-/// step nearest to k / fps s. Frames past the last step show the final state. A step that
-/// fails stops the run with no more frames: its failure is returned in `Ok(Some(..))`,
-/// so that the caller can still write the frames it has; `Err` is the callback's own.
+/// Steps `scene` through `plan` (its character's move, then the world's step), calling
+/// `frame(world, k)` for frame k = 0, 1, ... at the step nearest to k / fps s. Frames past
+/// the last step show the final state. A step that fails stops the run with no more
+/// frames: its failure is returned in `Ok(Some(..))`, so that the caller can still write
+/// the frames it has; `Err` is the callback's own.
 pub fn run_frames(
-    world: &mut World,
+    scene: &mut Scene,
     plan: &RunPlan,
     fps: Real,
     progress: &mut Progress,
     mut frame: impl FnMut(&World, u64) -> Result<(), Failure>,
 ) -> Result<Option<Failure>, Failure> {
     let frames = frame_count(plan, fps);
-    frame(world, 0)?;
+    frame(&scene.world, 0)?;
     let mut next = 1;
     for k in 1..=plan.steps {
         let h = plan.step_dt(k);
-        if let Err(e) = world.step(h) {
+        if let Err(e) = scene.step(h) {
             return Ok(Some(step_failure(k, e)));
         }
         let t = plan.time_after(k);
         while next < frames && t + 0.5 * h >= next as Real / fps {
-            frame(world, next)?;
+            frame(&scene.world, next)?;
             next += 1;
         }
         progress.inc(1);
     }
     while next < frames {
-        frame(world, next)?;
+        frame(&scene.world, next)?;
         next += 1;
     }
     Ok(None)

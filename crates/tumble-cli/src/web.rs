@@ -258,39 +258,33 @@ fn record(
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut snapshots = Vec::new();
     let mut progress = Progress::new(plan.steps, "recording", args.quiet);
-    let stopped = run_frames(
-        &mut scene.world,
-        plan,
-        args.fps,
-        &mut progress,
-        |world: &World, k| {
-            times.push(r(k as Real / args.fps));
-            let (mut p, mut q, mut v, mut w, mut l) = (vec![], vec![], vec![], vec![], vec![]);
-            for (_, body) in world.bodies() {
-                v3(&mut p, body.position());
-                let o = body.orientation();
-                q.extend([r(o.x), r(o.y), r(o.z), r(o.w)]);
-                v3(&mut v, body.linear_velocity());
-                v3(&mut w, body.angular_velocity());
-                v3(&mut l, body.angular_momentum());
-            }
-            position.push(Value::Array(p));
-            orientation.push(Value::Array(q));
-            velocity.push(Value::Array(v));
-            omega.push(Value::Array(w));
-            momentum.push(Value::Array(l));
-            let d = world.diagnostics();
-            kinetic.push(r(d.kinetic));
-            potential.push(r(d.potential));
-            total.push(r(d.total));
-            l_norm.push(r(d.angular_momentum.length()));
-            // Enough snapshots to frame the run, not all of them.
-            if k % 8 == 0 {
-                snapshots.push(Snapshot::capture(world));
-            }
-            Ok(())
-        },
-    )?;
+    let stopped = run_frames(scene, plan, args.fps, &mut progress, |world: &World, k| {
+        times.push(r(k as Real / args.fps));
+        let (mut p, mut q, mut v, mut w, mut l) = (vec![], vec![], vec![], vec![], vec![]);
+        for (_, body) in world.bodies() {
+            v3(&mut p, body.position());
+            let o = body.orientation();
+            q.extend([r(o.x), r(o.y), r(o.z), r(o.w)]);
+            v3(&mut v, body.linear_velocity());
+            v3(&mut w, body.angular_velocity());
+            v3(&mut l, body.angular_momentum());
+        }
+        position.push(Value::Array(p));
+        orientation.push(Value::Array(q));
+        velocity.push(Value::Array(v));
+        omega.push(Value::Array(w));
+        momentum.push(Value::Array(l));
+        let d = world.diagnostics();
+        kinetic.push(r(d.kinetic));
+        potential.push(r(d.potential));
+        total.push(r(d.total));
+        l_norm.push(r(d.angular_momentum.length()));
+        // Enough snapshots to frame the run, not all of them.
+        if k % 8 == 0 {
+            snapshots.push(Snapshot::capture(world));
+        }
+        Ok(())
+    })?;
     snapshots.push(Snapshot::capture(&scene.world));
     progress.finish();
 

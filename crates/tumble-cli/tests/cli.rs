@@ -588,3 +588,39 @@ fn sensor_events_are_written_at_every_step() {
     assert!(line.starts_with("sensors: '") && line.ends_with("is a folder; name a file"));
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// `tumble run character_course` walks its character: the walker's rows of the trajectory
+/// start where the scene puts it and, 5 s in (at 2 m/s, up the ramp, over the plateau and
+/// down the stairs), are past the stairs (x > 8 m) and back on the floor, its centre
+/// 0.92 m up (radius + half height + skin, to half a skin); the scene's other bodies stay
+/// where they are. A scene file with a bad character is refused in one line.
+#[test]
+fn the_character_course_walks_its_character() {
+    let dir = scratch("character");
+    let out = dir.join("walk.csv");
+    ok(&[
+        "run",
+        "character_course",
+        "--steps",
+        "300",
+        "--out",
+        path(&out),
+        "-q",
+    ]);
+    let (_, rows) = rows(&out);
+    let walker: Vec<&Vec<String>> = rows.iter().filter(|r| r[1] == "walker").collect();
+    assert_eq!(walker.len(), 301);
+    let (first, last) = (walker[0], walker[300]);
+    assert_eq!((num(&first[2]), num(&first[3])), (0.0, 0.92));
+    assert!(num(&last[2]) > 8.0, "{last:?}");
+    assert!((num(&last[3]) - 0.92).abs() <= 0.01, "{last:?}");
+    let ramp: Vec<&Vec<String>> = rows.iter().filter(|r| r[1] == "ramp").collect();
+    assert_eq!(ramp.first().unwrap()[2..5], ramp.last().unwrap()[2..5]);
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, r#"{"character": {"radius": 0}}"#).unwrap();
+    assert_eq!(
+        refused(&["run", path(&bad)]),
+        "character.radius: must be > 0"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -5,7 +5,7 @@
 //! file in `scenes/` is listed here.
 
 /// Name and JSON text of every built-in scene; the seed's free fall first.
-const SCENES: [(&str, &str); 13] = [
+const SCENES: [(&str, &str); 14] = [
     ("free_fall", include_str!("../../../scenes/free_fall.json")),
     ("spring", include_str!("../../../scenes/spring.json")),
     (
@@ -33,6 +33,10 @@ const SCENES: [(&str, &str); 13] = [
     (
         "pendulum_chain",
         include_str!("../../../scenes/pendulum_chain.json"),
+    ),
+    (
+        "character_course",
+        include_str!("../../../scenes/character_course.json"),
     ),
 ];
 

@@ -14,6 +14,7 @@
 
 mod body;
 pub mod builtin;
+mod character;
 mod error;
 mod force;
 mod joint;
@@ -30,6 +31,7 @@ use tumble::{Integrator, Real, SolverKind, SolverSettings, SpeedLimits, Vec3, Wo
 
 pub use body::BODY_KINDS;
 pub use builtin::{builtin, builtin_names};
+pub use character::{Leg, Walker};
 pub use error::{printable, Result, SceneError};
 pub use force::FORCE_TYPES;
 pub use joint::JOINT_TYPES;
@@ -41,7 +43,7 @@ pub use body::check_name;
 
 use reader::{Node, Obj};
 
-const TOP_KEYS: [&str; 23] = [
+const TOP_KEYS: [&str; 24] = [
     "name",
     "description",
     "gravity",
@@ -65,6 +67,7 @@ const TOP_KEYS: [&str; 23] = [
     "max_contacts",
     "max_contacts_per_body",
     "max_push_speed",
+    "character",
 ];
 
 /// The most `substeps` and `iterations` a scene or the command line may ask for.
@@ -92,12 +95,25 @@ pub struct Scene {
     pub body_names: Vec<String>,
     /// Each body's `color` as RGB, creation order; `None` where the scene gives none.
     pub body_colors: Vec<Option<[u8; 3]>>,
+    /// The scene's `character`, walked along its path by [`Scene::step`]; its body is the
+    /// last of the world's.
+    pub character: Option<Walker>,
 }
 
 impl Scene {
     /// The steps of a run of `duration` with `dt` (see [`RunPlan`]).
     pub fn plan(&self) -> Result<RunPlan> {
         RunPlan::from_duration(self.duration, self.dt)
+    }
+
+    /// One step of the run, `dt` (s): the character's move, if the scene has one (see
+    /// [`Walker::advance`]), then the world's step. A run that steps `world` itself
+    /// leaves the character standing where it started.
+    pub fn step(&mut self, dt: Real) -> tumble::Result<()> {
+        if let Some(walker) = &mut self.character {
+            walker.advance(&mut self.world, dt)?;
+        }
+        self.world.step(dt)
     }
 }
 
@@ -192,9 +208,18 @@ fn build(root: &Node<'_>) -> Result<Scene> {
     // Checked now, so a bad value is reported as the scene's, not when a run starts.
     plan::check_settings(duration, dt)?;
     let mut world = World::try_new(&def).map_err(|e| SceneError::from_engine(e, ""))?;
-    let (body_names, body_colors) = add_bodies(&obj, &mut world)?;
+    let (mut body_names, mut body_colors) = add_bodies(&obj, &mut world)?;
     add_forces(&obj, &mut world)?;
     add_joints(&obj, &mut world)?;
+    let character = match obj.get("character") {
+        Some(node) => {
+            let (walker, label, color) = character::character(&node, &mut world)?;
+            body_names.push(label);
+            body_colors.push(color);
+            Some(walker)
+        }
+        None => None,
+    };
     Ok(Scene {
         name,
         description,
@@ -203,6 +228,7 @@ fn build(root: &Node<'_>) -> Result<Scene> {
         duration,
         body_names,
         body_colors,
+        character,
     })
 }
 

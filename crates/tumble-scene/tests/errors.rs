@@ -40,7 +40,7 @@ fn misspelt_keys_are_refused_with_the_allowed_ones() {
         "gravityy: unknown key (expected one of: name, description, gravity, dt, duration, \
          integrator, bodies, forces, joints, solver, substeps, iterations, contact_hertz, \
          contact_damping_ratio, joint_hertz, joint_damping_ratio, length_unit, sleep, max_speed, \
-         max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed)"
+         max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed, character)"
     );
     assert_eq!(
         error(&one_body(r#""velocty": [1, 0, 0]"#)),
@@ -327,7 +327,7 @@ fn files_that_cannot_be_read_are_reported() {
     assert_eq!(
         e.to_string(),
         "scene: 'no_such_scene' is neither a built-in scene (free_fall, spring, double_spring, \
-         dzhanibekov, planar_spinner, dumbbell, resting, door, cradle, rope_bridge, ragdoll, pyramid, pendulum_chain) nor an existing file"
+         dzhanibekov, planar_spinner, dumbbell, resting, door, cradle, rope_bridge, ragdoll, pyramid, pendulum_chain, character_course) nor an existing file"
     );
 }
 
@@ -338,7 +338,7 @@ fn user_text_cannot_break_the_line() {
         "du\\nration: unknown key (expected one of: name, description, gravity, dt, duration, \
          integrator, bodies, forces, joints, solver, substeps, iterations, contact_hertz, \
          contact_damping_ratio, joint_hertz, joint_damping_ratio, length_unit, sleep, max_speed, \
-         max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed)"
+         max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed, character)"
     );
     assert_eq!(error(r#"{"integrator": "rk\n4"}"#).lines().count(), 1);
     assert_eq!(

@@ -710,3 +710,80 @@ class World:
         """Energies, momentum and angular momentum of the current state."""
     def state_hash(self) -> int:
         """Equal hashes mean bit-identical states."""
+
+class Push:
+    """An impulse a character's move gave a dynamic body in its way."""
+
+    body: Body
+    """The body pushed."""
+    impulse: F64Array
+    """The impulse (N·s, world), (3,); no longer than max_push_force·dt."""
+    point: F64Array
+    """Where it was applied (m, world), (3,)."""
+
+class CharacterController:
+    """A kinematic capsule that walks in a world: ``move(displacement, dt)`` slides along
+    walls, climbs slopes up to ``max_slope`` (rad) and steps up to ``step_height`` (m),
+    follows the ground down slopes and stairs, keeps ``skin`` from every surface, never
+    tunnels, and pushes dynamic bodies with at most ``max_push_force``·dt per move. Gravity
+    is the caller's (add it while ``on_ground`` is False). Not a body: other bodies do not
+    collide with it. Bad values raise ValueError naming the field
+    (``character.radius: must be > 0``)."""
+
+    def __init__(
+        self,
+        world: World,
+        *,
+        radius: float = 0.3,
+        half_height: float = 0.6,
+        position: Optional[Vec3Like] = None,
+        max_slope: float = 0.7853981633974483,
+        step_height: float = 0.3,
+        skin: float = 0.02,
+        snap_distance: float = 0.3,
+        max_push_force: float = 1000.0,
+        up: Optional[Vec3Like] = None,
+        collision_mask: int = 0xFFFFFFFF,
+        exclude: Optional[BodyLike] = None,
+    ) -> None: ...
+    def move(self, displacement: Vec3Like, dt: float) -> None:
+        """Moves the character by ``displacement`` (m) over ``dt`` (s)."""
+    @property
+    def world(self) -> World:
+        """The world it walks in."""
+    @property
+    def position(self) -> F64Array:
+        """The capsule's centre (m), (3,); assignable (placed there, not swept)."""
+    @position.setter
+    def position(self, value: Vec3Like) -> None: ...
+    @property
+    def on_ground(self) -> bool:
+        """Whether the last move (or the start) left it on walkable ground."""
+    @property
+    def ground_normal(self) -> Optional[F64Array]:
+        """The unit normal of the ground it stands on, or None in the air."""
+    @property
+    def ground_body(self) -> Optional[Body]:
+        """The body it stands on, or None in the air."""
+    @property
+    def velocity(self) -> F64Array:
+        """The last move's displacement over its dt (m/s)."""
+    @property
+    def pushes(self) -> list[Push]:
+        """The impulses the last move gave dynamic bodies."""
+    @property
+    def radius(self) -> float: ...
+    @property
+    def half_height(self) -> float: ...
+    @property
+    def max_slope(self) -> float: ...
+    @property
+    def step_height(self) -> float: ...
+    @property
+    def skin(self) -> float: ...
+    @property
+    def snap_distance(self) -> float: ...
+    @property
+    def max_push_force(self) -> float: ...
+    @property
+    def up(self) -> F64Array: ...

@@ -11,12 +11,15 @@
 //! sensors        sensors' overlaps and their begin/end events
 //! speculative    speculative contacts the step will not reach (no ghost collisions)
 //! ccd            sweeps of fast bodies back to their time of impact
+//! character/     the character controller: a kinematic capsule that slides, climbs
+//!                slopes and steps, snaps to the ground and pushes bodies, over `&World`
 //! diagnostics    energies, momenta, state hash
 //! analysis       convergence order, energy behaviour, stability of the integrators
 //! ```
 
 pub mod analysis;
 pub(crate) mod ccd;
+pub mod character;
 pub mod contact_cache;
 pub mod diagnostics;
 pub mod hooks;
