@@ -69,7 +69,8 @@ fn a_body_in_contact_calls_back_once_per_substep_and_a_joined_one_once_more() {
 #[test]
 fn a_callback_sees_each_body_as_it_is_at_the_first_evaluation_of_a_step() {
     // Under symplectic Euler the one evaluation is at the step's start: the state the
-    // callback reads is the world's before the step, bit for bit, in creation order.
+    // callback reads is the world's before the step, bit for bit, in creation order (the
+    // box's centre of mass off its frame's origin, so that the two differ).
     let mut w = common::world(Vec3::ZERO, Integrator::SymplecticEuler);
     let a = w
         .create_body(
@@ -79,6 +80,8 @@ fn a_callback_sees_each_body_as_it_is_at_the_first_evaluation_of_a_step() {
                 linear_velocity: Vec3::new(0.5, -0.25, 2.0),
                 angular_velocity: Vec3::new(0.0, 3.0, 1.0),
                 mass: MassSpec::Mass(2.5),
+                center_of_mass: Some(Vec3::new(0.1, 0.0, 0.0)),
+                name: Some("box".into()),
                 ..Default::default()
             },
             Shape::cuboid(Vec3::new(0.3, 0.2, 0.1)),
@@ -91,6 +94,11 @@ fn a_callback_sees_each_body_as_it_is_at_the_first_evaluation_of_a_step() {
         let all = (0..ctx.body_count()).map(|i| ctx.state_at(i).unwrap());
         *s.lock().unwrap() = all.collect::<Vec<_>>();
         assert!(ctx.state_at(ctx.body_count()).is_none());
+        assert_eq!(ctx.body_ids(), [a, b]);
+        assert_eq!(
+            (ctx.name_at(0), ctx.name_at(1), ctx.name_at(2)),
+            (Some("box"), None, None)
+        );
     }));
     for _ in 0..3 {
         let expected: Vec<_> = [a, b]

@@ -89,7 +89,9 @@ pub enum Force {
 }
 
 impl Force {
-    pub(crate) fn validate(&self) -> Result<()> {
+    /// Checks the element's values (not its bodies): the rule `World::add_force` applies,
+    /// its fields named as the element's (`force: must be finite numbers`).
+    pub fn validate(&self) -> Result<()> {
         match self {
             Force::Spring(s) => {
                 check::vec3_at_most("anchor", s.anchor, MAX_COORDINATE, "m")?;
@@ -148,6 +150,7 @@ pub type ForceCallback = Box<dyn FnMut(&mut ForceContext<'_>) + Send>;
 pub struct ForceContext<'a> {
     pub(crate) time: Real,
     pub(crate) bodies: &'a [Body],
+    pub(crate) ids: &'a [BodyId],
     pub(crate) motions: &'a [Motion],
     pub(crate) lookup: &'a dyn Fn(BodyId) -> Option<usize>,
     pub(crate) out: &'a mut [Wrench],
@@ -175,6 +178,14 @@ impl ForceContext<'_> {
     /// How many bodies the world has: [`ForceContext::state_at`] takes 0 to this − 1.
     pub fn body_count(&self) -> usize {
         self.motions.len()
+    }
+    /// Every body's handle, in creation order (the indices of [`ForceContext::state_at`]).
+    pub fn body_ids(&self) -> &[BodyId] {
+        self.ids
+    }
+    /// Body `index`'s name (creation order), if it has one.
+    pub fn name_at(&self, index: usize) -> Option<&str> {
+        self.bodies.get(index)?.name()
     }
     /// Body `index`'s state in this evaluation, bodies in creation order (the order of
     /// `World::body_ids`), or `None` past the last. For reading many bodies at once.

@@ -110,6 +110,8 @@ pub(crate) struct System<'a> {
     pub gravity: Vec3,
     pub forces: &'a [Force],
     pub bodies: &'a [Body],
+    /// Each body's handle, in the order of `bodies`.
+    pub ids: &'a [BodyId],
     pub lookup: &'a dyn Fn(BodyId) -> Option<usize>,
     pub callbacks: &'a mut [ForceCallback],
     /// Set by the first callback that fails the step; no callback runs after it.
@@ -137,6 +139,7 @@ impl System<'_> {
             let mut ctx = ForceContext {
                 time: t,
                 bodies: self.bodies,
+                ids: self.ids,
                 motions,
                 lookup: self.lookup,
                 out,

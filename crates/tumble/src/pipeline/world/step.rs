@@ -192,7 +192,12 @@ impl World {
             .extend((0..bodies.len()).map(|i| ctx.bodies.motion(i)));
         let handles = &self.bodies.handles;
         let find = |id: BodyId| handles.dense(id);
-        let mut system = system(&self.settings, &mut self.forces, bodies, &find);
+        let mut system = system(
+            &self.settings,
+            &mut self.forces,
+            (bodies, handles.ids()),
+            &find,
+        );
         integrate::advance(
             self.settings.integrator,
             &mut system,
@@ -221,7 +226,12 @@ impl World {
         }
         let handles = &self.bodies.handles;
         let find = |id: BodyId| handles.dense(id);
-        let mut system = system(&self.settings, &mut self.forces, &self.bodies.list, &find);
+        let mut system = system(
+            &self.settings,
+            &mut self.forces,
+            (&self.bodies.list, handles.ids()),
+            &find,
+        );
         let input = StepInput {
             system: &mut system,
             settings: &self.settings.solver,
@@ -307,13 +317,14 @@ impl World {
 fn system<'a>(
     settings: &crate::pipeline::world::Settings,
     forces: &'a mut crate::pipeline::world::ForceStore,
-    bodies: &'a [crate::dynamics::body::Body],
+    (bodies, ids): (&'a [crate::dynamics::body::Body], &'a [BodyId]),
     find: &'a dyn Fn(BodyId) -> Option<usize>,
 ) -> System<'a> {
     System {
         gravity: settings.gravity,
         forces: &forces.list,
         bodies,
+        ids,
         lookup: find,
         callbacks: &mut forces.callbacks,
         failure: &mut forces.failure,
