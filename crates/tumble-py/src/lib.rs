@@ -10,6 +10,7 @@
 
 mod body;
 mod bulk;
+mod callbacks;
 mod convert;
 mod joint_control;
 mod joints;
@@ -46,5 +47,6 @@ fn tumble_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     sim::register(m)?;
     query::register(m)?;
     joints::register(m)?;
+    callbacks::register(m)?;
     Ok(())
 }

@@ -26,6 +26,9 @@ pub struct Inner {
     pub dt: Real,
     /// Default length of `simulate` (s): the scene's `duration`, else 1.
     pub duration: Real,
+    /// The context of the world's Python force callbacks, made with the first one
+    /// (`callbacks.rs`); `None` while it has none.
+    pub callbacks: Option<Py<crate::callbacks::PyForceContext>>,
 }
 
 /// A simulated world: bodies, force elements, joints, and the step that advances them.
@@ -372,6 +375,7 @@ impl PyWorld {
             world,
             dt: tumble_scene::DEFAULT_DT,
             duration: tumble_scene::DEFAULT_DURATION,
+            callbacks: None,
         }))
     }
 
@@ -386,6 +390,7 @@ impl PyWorld {
             world: s.world,
             dt: s.dt,
             duration: s.duration,
+            callbacks: None,
         }))
     }
 
@@ -397,6 +402,7 @@ impl PyWorld {
             world: s.world,
             dt: s.dt,
             duration: s.duration,
+            callbacks: None,
         }))
     }
 
@@ -624,13 +630,12 @@ impl PyWorld {
     #[pyo3(signature = (dt, steps = 1))]
     fn step(&self, py: Python<'_>, dt: f64, steps: u64) -> PyResult<()> {
         let mut g = self.lock()?;
-        let world = &mut g.world;
         let dt = real(dt);
         // Releasing and retaking the interpreter lock costs about what stepping an empty
         // world does, so a short step keeps it; counting an empty world as one body, so
         // that many steps of it (long, however cheap each) let other threads run.
-        let release = (world.body_count().max(1) as u64).saturating_mul(steps) >= 64;
-        crate::steps::run(py, world, steps, release, |_| dt, |_, _| ())?;
+        let release = (g.world.body_count().max(1) as u64).saturating_mul(steps) >= 64;
+        crate::steps::run(py, &mut g, steps, release, |_| dt, |_, _| ())?;
         Ok(())
     }
 
