@@ -19,16 +19,41 @@
 //! The world is locked while it steps, so fn reads state through ctx, not through the
 //! world or its bodies (those raise RuntimeError, "the world is busy", which stops the
 //! step like any exception).
+//!
+//! A callback usually holds a body of its world: function -> Body -> World -> engine
+//! closure -> context -> function is a cycle. The functions are kept in the context, not
+//! the closures, and the handles, the world and the context tell the garbage collector
+//! their references (`__traverse__`), so that it can free such a world.
 
 use numpy::PyArray1;
 use pyo3::exceptions::PyRuntimeError;
+use pyo3::gc::PyVisit;
 use pyo3::prelude::*;
+use pyo3::PyTraverseError;
+use tumble::Vec3;
 use tumble::{AppliedForce, BodyId, EvaluatedState, Force, ForceCallback, ForceContext, Real};
-use tumble::{Vec3, World};
 
 use crate::body::PyBody;
 use crate::convert::{engine, invalid, quat_out, vec3, vec3_out, wide, wrong_type};
-use crate::world::PyWorld;
+use crate::world::{Inner, PyWorld};
+
+/// A world's Python force callbacks: their context, and how many of the engine's closures
+/// hold a reference to it (one per callback).
+pub struct Callbacks {
+    pub ctx: Py<PyForceContext>,
+    closures: usize,
+}
+
+impl Callbacks {
+    /// The references the world holds to Python objects, for the garbage collector: the
+    /// context, once from here and once from each closure.
+    pub fn traverse(&self, visit: &PyVisit<'_>) -> Result<(), PyTraverseError> {
+        for _ in 0..=self.closures {
+            visit.call(&self.ctx)?;
+        }
+        Ok(())
+    }
+}
 
 /// What a force callback sees: the state of every body at the force evaluation being
 /// made (`time`, and per body `position`, `center_of_mass`, `orientation`, `velocity`,
@@ -53,6 +78,10 @@ pub struct PyForceContext {
     pushes: Vec<(usize, Vec3, Vec3)>,
     /// The exception that stopped the step, until the step loop raises it.
     error: Option<PyErr>,
+    /// The world's Python callbacks, in the order added; the engine's closure of the
+    /// k-th calls `functions[k]`. Here rather than in the closures so that the garbage
+    /// collector sees them (see `__traverse__`).
+    functions: Vec<Py<PyAny>>,
 }
 
 impl PyForceContext {
@@ -67,6 +96,7 @@ impl PyForceContext {
             states: Vec::new(),
             pushes: Vec::new(),
             error: None,
+            functions: Vec::new(),
         }
     }
 
@@ -155,6 +185,21 @@ impl PyForceContext {
 
 #[pymethods]
 impl PyForceContext {
+    // A callback that holds a body of its world (the usual case) makes a cycle: function
+    // -> Body -> World -> (engine closure) -> this -> function. The handles and the world
+    // report their references, this reports the functions and drops them when the
+    // collector breaks the cycle (the engine's closures then call nothing).
+    fn __traverse__(&self, visit: PyVisit<'_>) -> Result<(), PyTraverseError> {
+        for f in &self.functions {
+            visit.call(f)?;
+        }
+        Ok(())
+    }
+
+    fn __clear__(&mut self) {
+        self.functions.clear();
+    }
+
     /// Simulated time of the state being evaluated (s).
     #[getter]
     fn time(&self) -> PyResult<f64> {
@@ -266,11 +311,11 @@ impl PyForceContext {
     }
 }
 
-/// The engine's callback that calls Python's `func` with the world's context `ctx`.
-fn python_force(func: Py<PyAny>, ctx: Py<PyForceContext>) -> ForceCallback {
+/// The engine's callback that calls the world's `k`-th Python callback with its context.
+fn python_force(ctx: Py<PyForceContext>, k: usize) -> ForceCallback {
     Box::new(move |rust: &mut ForceContext<'_>| {
         Python::attach(|py| {
-            if let Err(e) = call(py, &func, ctx.bind(py), rust) {
+            if let Err(e) = call(py, ctx.bind(py), k, rust) {
                 let reason = e.to_string();
                 rust.fail(reason);
                 // The engine calls no callback after a failure, so this is the step's
@@ -283,13 +328,18 @@ fn python_force(func: Py<PyAny>, ctx: Py<PyForceContext>) -> ForceCallback {
     })
 }
 
-/// One call: the context opened on `rust`, `func(ctx)`, the forces handed over.
+/// One call: the context opened on `rust`, the `k`-th function called with it, the forces
+/// handed over.
 fn call(
     py: Python<'_>,
-    func: &Py<PyAny>,
     ctx: &Bound<'_, PyForceContext>,
+    k: usize,
     rust: &mut ForceContext<'_>,
 ) -> PyResult<()> {
+    let Some(func) = ctx.try_borrow()?.functions.get(k).map(|f| f.clone_ref(py)) else {
+        // Cleared by the garbage collector: the world is being freed.
+        return Ok(());
+    };
     ctx.try_borrow_mut()?.begin(rust);
     let result = func.call1(py, (ctx,));
     let mut c = ctx.try_borrow_mut()?;
@@ -299,22 +349,28 @@ fn call(
     Ok(())
 }
 
-/// The world's context, made with its first Python callback.
-fn context(
-    world: &Bound<'_, PyWorld>,
-    slot: &mut Option<Py<PyForceContext>>,
-) -> PyResult<Py<PyForceContext>> {
-    if let Some(ctx) = slot {
-        return Ok(ctx.clone_ref(world.py()));
+/// Adds `func` to the world of `inner` as a force callback, with the world's context
+/// (made with its first callback).
+fn add(world: &Bound<'_, PyWorld>, inner: &mut Inner, func: &Bound<'_, PyAny>) -> PyResult<()> {
+    let py = world.py();
+    let mut callbacks = match inner.callbacks.take() {
+        Some(c) => c,
+        None => Callbacks {
+            ctx: Py::new(py, PyForceContext::new(world))?,
+            closures: 0,
+        },
+    };
+    let pushed = callbacks.ctx.bind(py).try_borrow_mut().map(|mut c| {
+        c.functions.push(func.clone().unbind());
+        c.functions.len() - 1
+    });
+    if let Ok(k) = pushed {
+        let closure = python_force(callbacks.ctx.clone_ref(py), k);
+        inner.world.add_force_callback(closure);
+        callbacks.closures += 1;
     }
-    let ctx = Py::new(world.py(), PyForceContext::new(world))?;
-    *slot = Some(ctx.clone_ref(world.py()));
-    Ok(ctx)
-}
-
-/// Adds `func` to `world` as a force callback.
-fn add(world: &mut World, func: Py<PyAny>, ctx: Py<PyForceContext>) {
-    world.add_force_callback(python_force(func, ctx));
+    inner.callbacks = Some(callbacks);
+    pushed.map(|_| ()).map_err(PyErr::from)
 }
 
 #[pymethods]
@@ -337,9 +393,7 @@ impl PyWorld {
             return Err(wrong_type("callback", "a callable fn(ctx)", callback));
         }
         let mut g = slf.get().lock()?;
-        let ctx = context(slf, &mut g.callbacks)?;
-        add(&mut g.world, callback.clone().unbind(), ctx);
-        Ok(())
+        add(slf, &mut g, callback)
     }
 }
 

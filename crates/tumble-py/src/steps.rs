@@ -58,7 +58,7 @@ pub fn run(
             let kept = inner
                 .callbacks
                 .as_ref()
-                .and_then(|ctx| ctx.borrow_mut(py).take_error());
+                .and_then(|c| c.ctx.borrow_mut(py).take_error());
             // Only a Python callback fails a step here, and it keeps its exception.
             Err(Stop::Python(kept.unwrap_or_else(|| {
                 let e = tumble::Error::CallbackFailed(failed);

@@ -5,7 +5,9 @@ use std::sync::{Mutex, MutexGuard, TryLockError};
 
 use numpy::PyArray1;
 use pyo3::exceptions::{PyKeyError, PyRuntimeError};
+use pyo3::gc::PyVisit;
 use pyo3::prelude::*;
+use pyo3::PyTraverseError;
 use tumble::limits::ContactLimits;
 use tumble::{
     AppliedForce, BodyDef, BodyId, BodyKind, Drag, Force, ForceId, InertiaSpec, MassSpec, Real,
@@ -26,9 +28,8 @@ pub struct Inner {
     pub dt: Real,
     /// Default length of `simulate` (s): the scene's `duration`, else 1.
     pub duration: Real,
-    /// The context of the world's Python force callbacks, made with the first one
-    /// (`callbacks.rs`); `None` while it has none.
-    pub callbacks: Option<Py<crate::callbacks::PyForceContext>>,
+    /// The world's Python force callbacks (`callbacks.rs`); `None` while it has none.
+    pub callbacks: Option<crate::callbacks::Callbacks>,
 }
 
 /// A simulated world: bodies, force elements, joints, and the step that advances them.
@@ -321,6 +322,15 @@ fn thread_count(n: i64) -> PyResult<usize> {
 
 #[pymethods]
 impl PyWorld {
+    // Tells the garbage collector what the world holds (see `callbacks.rs`). A world that
+    // is stepping (its lock held) reports nothing: it is in use, so not garbage.
+    fn __traverse__(&self, visit: PyVisit<'_>) -> Result<(), PyTraverseError> {
+        match self.inner.try_lock() {
+            Ok(g) => g.callbacks.as_ref().map_or(Ok(()), |c| c.traverse(&visit)),
+            Err(_) => Ok(()),
+        }
+    }
+
     #[new]
     #[pyo3(signature = (*, gravity = None, integrator = "symplectic_euler".to_string(),
         solver = "soft_step".to_string(), substeps = 4, iterations = 1, contact_hertz = 60.0,

@@ -460,3 +460,33 @@ def test_a_world_asleep_calls_no_callback_and_adding_one_wakes_it():
     world.step(1 / 60, steps=10)
     assert len(calls) - n >= 10  # at least once a step again
     assert ball.position[1] > 0.1
+
+
+def test_a_world_whose_callback_holds_its_body_is_collected():
+    # callback -> Body (or Joint) -> World -> the engine's closure -> callback: a cycle,
+    # which the garbage collector must see through (the handles, the world and the
+    # context report their references) or every such world would live until the
+    # interpreter exits. A token held by the callbacks tells whether they were freed.
+    import gc
+    import weakref
+
+    class Token:
+        pass
+
+    def build(integrator, token, held):
+        world, ball = free_ball(integrator)
+        hinge = world.add_joint("ball", ball, anchor=(-1, 0, 0))
+        if held == "body":
+            world.add_force_callback(lambda ctx: token and ctx.add_force(ball, (1, 0, 0)))
+        else:
+            world.add_force_callback(lambda ctx: token and hinge and None)
+        world.simulate(steps=3, dt=0.01, controller=lambda w, t: None)
+
+    refs = []
+    for integrator, held in (("rk4", "body"), ("symplectic_euler", "joint")):
+        token = Token()
+        refs.append(weakref.ref(token))
+        build(integrator, token, held)
+        del token
+    gc.collect()
+    assert [r() for r in refs] == [None, None]
