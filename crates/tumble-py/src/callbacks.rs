@@ -74,8 +74,9 @@ pub struct PyForceContext {
     open: bool,
     time: Real,
     states: Vec<EvaluatedState>,
-    /// Forces given: dense index, force (N) and torque about the centre of mass (N·m).
-    pushes: Vec<(usize, Vec3, Vec3)>,
+    /// Forces given: dense index, force (N), where it acts (body frame, m; `None`: the
+    /// centre of mass) and torque (N·m).
+    pushes: Vec<(usize, Vec3, Option<Vec3>, Vec3)>,
     /// The exception that stopped the step, until the step loop raises it.
     error: Option<PyErr>,
     /// The world's Python callbacks, in the order added; the engine's closure of the
@@ -133,9 +134,13 @@ impl PyForceContext {
     /// Closes the context and hands the forces given to the engine.
     fn finish(&mut self, rust: &mut ForceContext<'_>) {
         self.open = false;
-        for &(i, force, torque) in &self.pushes {
-            rust.add_force(self.ids[i], force);
-            rust.add_torque(self.ids[i], torque);
+        for &(i, force, point, torque) in &self.pushes {
+            let id = self.ids[i];
+            match point {
+                Some(p) => rust.add_force_at_local_point(id, force, p),
+                None => rust.add_force(id, force),
+            };
+            rust.add_torque(id, torque);
         }
     }
 
@@ -275,12 +280,8 @@ impl PyForceContext {
             torque: Vec3::ZERO,
         };
         Force::Applied(applied).validate().map_err(engine)?;
-        let s = &self.states[i];
-        let torque = match applied.point {
-            Some(p) => (s.position + s.orientation * p - s.center_of_mass).cross(applied.force),
-            None => Vec3::ZERO,
-        };
-        self.pushes.push((i, applied.force, torque));
+        self.pushes
+            .push((i, applied.force, applied.point, Vec3::ZERO));
         Ok(())
     }
 
@@ -294,7 +295,7 @@ impl PyForceContext {
             torque: vec3(torque, "torque")?,
         };
         Force::Applied(applied).validate().map_err(engine)?;
-        self.pushes.push((i, Vec3::ZERO, applied.torque));
+        self.pushes.push((i, Vec3::ZERO, None, applied.torque));
         Ok(())
     }
 

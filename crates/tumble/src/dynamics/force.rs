@@ -249,6 +249,24 @@ impl ForceContext<'_> {
             None => false,
         }
     }
+    /// Adds a force acting at `local_point` (body frame, m), as an [`AppliedForce`] with
+    /// that `point` does: it also adds the torque r × F. Returns false for an unknown body.
+    pub fn add_force_at_local_point(
+        &mut self,
+        body: BodyId,
+        force: Vec3,
+        local_point: Vec3,
+    ) -> bool {
+        match (self.lookup)(body) {
+            Some(i) => {
+                let r = self.motions[i].q * (local_point - self.bodies[i].local_center);
+                self.out[i].force += force;
+                self.out[i].torque += r.cross(force);
+                true
+            }
+            None => false,
+        }
+    }
     /// Adds a torque (N·m).
     pub fn add_torque(&mut self, body: BodyId, torque: Vec3) -> bool {
         self.add_wrench(body, Vec3::ZERO, torque)
