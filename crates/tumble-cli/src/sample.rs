@@ -51,9 +51,9 @@ pub fn run_frames(
 /// gets the step's number in front.
 pub fn step_failure(k: u64, e: tumble::Error) -> Failure {
     match e {
-        tumble::Error::Unstable(_) | tumble::Error::TooManyContacts(_) => {
-            Failure::Runtime(e.to_string())
-        }
+        tumble::Error::Unstable(_)
+        | tumble::Error::TooManyContacts(_)
+        | tumble::Error::CallbackFailed(_) => Failure::Runtime(e.to_string()),
         other => Failure::Runtime(format!("step {k}: {other}")),
     }
 }

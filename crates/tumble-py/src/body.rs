@@ -350,6 +350,12 @@ impl PyBody {
         self.edit(|g, id| g.world.wake_body(id))
     }
 
+    // The world, for the garbage collector: a force callback that holds a body of its
+    // world makes a cycle through it (see `callbacks.rs`).
+    fn __traverse__(&self, visit: pyo3::gc::PyVisit<'_>) -> Result<(), pyo3::PyTraverseError> {
+        visit.call(&self.world)
+    }
+
     fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
         other.cast::<PyBody>().is_ok_and(|o| {
             let o = o.get();

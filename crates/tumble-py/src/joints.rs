@@ -121,6 +121,11 @@ impl PyJoint {
 
 #[pymethods]
 impl PyJoint {
+    // The world, for the garbage collector (see `PyBody::__traverse__`).
+    fn __traverse__(&self, visit: pyo3::gc::PyVisit<'_>) -> Result<(), pyo3::PyTraverseError> {
+        visit.call(&self.world)
+    }
+
     /// The joint's name, or None.
     #[getter]
     fn name(&self) -> PyResult<Option<String>> {

@@ -10,6 +10,7 @@
 
 mod body;
 mod bulk;
+mod callbacks;
 mod character;
 mod convert;
 mod joint_control;
@@ -48,5 +49,6 @@ fn tumble_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     query::register(m)?;
     joints::register(m)?;
     character::register(m)?;
+    callbacks::register(m)?;
     Ok(())
 }

@@ -9,9 +9,9 @@ use pyo3::prelude::*;
 use tumble::{Quat, Real, Vec3, World};
 use tumble_scene::RunPlan;
 
-use crate::convert::{failed_step, invalid, real, scene, wide};
+use crate::convert::{failed_step, invalid, real, scene, wide, wrong_type};
 use crate::steps::Stop;
-use crate::world::PyWorld;
+use crate::world::{Inner, PyWorld};
 
 /// A recorded run: step 0, every `every`-th step and the last. `time` (T,) in s;
 /// `position` (T, N, 3) of each body frame's origin in m; `orientation` (T, N, 4) as
@@ -197,14 +197,14 @@ fn check_fits(
 /// it stops early, `rec` holds every frame up to the last good step.
 fn run(
     py: Python<'_>,
-    world: &mut World,
+    inner: &mut Inner,
     plan: RunPlan,
     every: u64,
     diagnostics: bool,
     rec: &mut Recording,
 ) -> Result<(), Stop> {
-    let start = world.time();
-    rec.frame(world, start, diagnostics);
+    let start = inner.world.time();
+    rec.frame(&inner.world, start, diagnostics);
     let dt = |k| plan.step_dt(k);
     let record = |k: u64, world: &World| {
         if k % every == 0 || k == plan.steps {
@@ -212,7 +212,51 @@ fn run(
             rec.frame(world, start + plan.time_after(k), diagnostics);
         }
     };
-    crate::steps::run(py, world, plan.steps, true, dt, record)
+    crate::steps::run(py, inner, plan.steps, true, dt, record)
+}
+
+/// `run` with a controller: `controller(world, t)` is called before every step with the
+/// Python world (unlocked, so that it can read joints and set motors) and the time the
+/// step starts from (s). Its exception stops the run before that step, and is raised.
+/// It may change the world but not which bodies it has: the recording's bodies are fixed.
+fn run_controlled(
+    world: &Bound<'_, PyWorld>,
+    controller: &Bound<'_, PyAny>,
+    plan: RunPlan,
+    (every, diagnostics): (u64, bool),
+    rec: &mut Recording,
+) -> Result<(), Stop> {
+    let py = world.py();
+    let lock = || world.get().lock().map_err(Stop::Python);
+    let (start, ids) = {
+        let g = lock()?;
+        rec.frame(&g.world, g.world.time(), diagnostics);
+        (g.world.time(), g.world.body_ids().to_vec())
+    };
+    for k in 1..=plan.steps {
+        let t = wide(lock()?.world.time());
+        controller.call1((world, t)).map_err(Stop::Python)?;
+        let mut g = lock()?;
+        if g.world.body_ids() != ids.as_slice() {
+            let reason = "added or removed a body; simulate records a fixed set of bodies";
+            return Err(Stop::Python(invalid("controller", reason)));
+        }
+        // One step at a time: releasing the interpreter's lock pays only for large worlds
+        // (and always with a Python force callback: see `steps::run`).
+        let release = g.world.body_count() >= 64;
+        let dt = plan.step_dt(k);
+        let record = |_, w: &World| {
+            if k % every == 0 || k == plan.steps {
+                rec.frame(w, start + plan.time_after(k), diagnostics);
+            }
+        };
+        crate::steps::run(py, &mut g, 1, release, |_| dt, record)?;
+        drop(g);
+        // The interpreter runs Python's signal handlers only between its own bytecodes:
+        // a controller that returns at once would leave Ctrl-C to the end of the run.
+        py.check_signals().map_err(Stop::Python)?;
+    }
+    Ok(())
 }
 
 pub fn array(py: Python<'_>, data: Vec<f64>, shape: &[usize]) -> PyResult<Py<PyAny>> {
@@ -281,7 +325,15 @@ impl PyWorld {
     /// run; Ctrl-C stops the run between two steps (KeyboardInterrupt); a step that is
     /// not finite or too fast raises SimulationError, whose `trajectory` is the run up to
     /// the last good step. The world is left at the last step completed.
-    #[pyo3(signature = (duration = None, dt = None, *, steps = None, every = 1, diagnostics = false))]
+    ///
+    /// `controller=fn` calls `fn(world, t)` before every step, with this World (it can
+    /// read joint coordinates and set motors, servos, forces, states) and the time the
+    /// step starts from (s); the loop then takes the interpreter's lock at every step.
+    /// An exception in fn, or in a force callback, stops the run before or during that
+    /// step, with the world as it was before the step, and is raised as it was.
+    #[pyo3(signature = (duration = None, dt = None, *, steps = None, every = 1,
+        diagnostics = false, controller = None))]
+    #[allow(clippy::too_many_arguments)]
     fn simulate(
         slf: &Bound<'_, Self>,
         duration: Option<f64>,
@@ -289,19 +341,31 @@ impl PyWorld {
         steps: Option<i64>,
         every: i64,
         diagnostics: bool,
+        controller: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Trajectory> {
         let py = slf.py();
         let every = u64::try_from(every)
             .ok()
             .filter(|&e| e >= 1)
             .ok_or_else(|| invalid("every", "must be >= 1"))?;
+        if let Some(c) = controller.filter(|c| !c.is_callable()) {
+            return Err(wrong_type("controller", "a callable fn(world, t)", c));
+        }
         let mut g = slf.get().lock()?;
         let (plan, field) = plan_of(&g, duration, dt, steps)?;
         let frames = frame_count(plan.steps, every);
         check_fits(py, field, frames, g.world.body_count(), diagnostics)?;
         let mut rec = Recording::with_capacity(frames as usize, g.world.body_count(), diagnostics)
             .map_err(|e| PyMemoryError::new_err(format!("{field}: the recording: {e}")))?;
-        let outcome = run(py, &mut g.world, plan, every, diagnostics, &mut rec);
+        let outcome = match controller {
+            None => run(py, &mut g, plan, every, diagnostics, &mut rec),
+            Some(c) => {
+                drop(g);
+                let outcome = run_controlled(slf, c, plan, (every, diagnostics), &mut rec);
+                g = slf.get().lock()?;
+                outcome
+            }
+        };
         let names = g
             .world
             .bodies()

@@ -10,8 +10,11 @@
 
 use std::time::{Duration, Instant};
 
+use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use tumble::{Real, World};
+
+use crate::world::Inner;
 
 /// How often a running loop looks for a signal: often enough that Ctrl-C feels immediate,
 /// rarely enough that taking the interpreter's lock costs nothing measurable (a check is
@@ -35,11 +38,38 @@ impl From<Stop> for PyErr {
     }
 }
 
-/// Steps `world` `steps` times, the k-th (from 1) of length `dt(k)`, calling `after(k,
-/// world)` after each; stops at the first refusal or raised signal. With `release` the
+/// Steps the world `steps` times, the k-th (from 1) of length `dt(k)`, calling `after(k,
+/// world)` after each; stops at the first refusal, raised signal or exception in a force
+/// callback (that exception, not the engine's `CallbackFailed`). With `release` the
 /// interpreter's lock is released for the run (worth it for long runs only: releasing and
-/// retaking it costs about what a step of an empty world does).
+/// retaking it costs about what a step of an empty world does); a world with a Python
+/// force callback always releases it, as the callback may run on another thread.
 pub fn run(
+    py: Python<'_>,
+    inner: &mut Inner,
+    steps: u64,
+    release: bool,
+    dt: impl Fn(u64) -> Real + Send,
+    after: impl FnMut(u64, &World) + Send,
+) -> Result<(), Stop> {
+    let release = release || inner.callbacks.is_some();
+    match run_world(py, &mut inner.world, steps, release, dt, after) {
+        Err(Stop::Engine(tumble::Error::CallbackFailed(failed))) => {
+            let kept = inner
+                .callbacks
+                .as_ref()
+                .and_then(|c| c.ctx.borrow_mut(py).take_error());
+            // Only a Python callback fails a step here, and it keeps its exception.
+            Err(Stop::Python(kept.unwrap_or_else(|| {
+                let e = tumble::Error::CallbackFailed(failed);
+                PyRuntimeError::new_err(e.to_string())
+            })))
+        }
+        outcome => outcome,
+    }
+}
+
+fn run_world(
     py: Python<'_>,
     world: &mut World,
     steps: u64,

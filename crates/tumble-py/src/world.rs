@@ -5,7 +5,9 @@ use std::sync::{Mutex, MutexGuard, TryLockError};
 
 use numpy::PyArray1;
 use pyo3::exceptions::{PyKeyError, PyRuntimeError};
+use pyo3::gc::PyVisit;
 use pyo3::prelude::*;
+use pyo3::PyTraverseError;
 use tumble::limits::ContactLimits;
 use tumble::{
     AppliedForce, BodyDef, BodyId, BodyKind, Drag, Force, ForceId, InertiaSpec, MassSpec, Real,
@@ -26,6 +28,8 @@ pub struct Inner {
     pub dt: Real,
     /// Default length of `simulate` (s): the scene's `duration`, else 1.
     pub duration: Real,
+    /// The world's Python force callbacks (`callbacks.rs`); `None` while it has none.
+    pub callbacks: Option<crate::callbacks::Callbacks>,
 }
 
 /// A simulated world: bodies, force elements, joints, and the step that advances them.
@@ -318,6 +322,15 @@ fn thread_count(n: i64) -> PyResult<usize> {
 
 #[pymethods]
 impl PyWorld {
+    // Tells the garbage collector what the world holds (see `callbacks.rs`). A world that
+    // is stepping (its lock held) reports nothing: it is in use, so not garbage.
+    fn __traverse__(&self, visit: PyVisit<'_>) -> Result<(), PyTraverseError> {
+        match self.inner.try_lock() {
+            Ok(g) => g.callbacks.as_ref().map_or(Ok(()), |c| c.traverse(&visit)),
+            Err(_) => Ok(()),
+        }
+    }
+
     #[new]
     #[pyo3(signature = (*, gravity = None, integrator = "symplectic_euler".to_string(),
         solver = "soft_step".to_string(), substeps = 4, iterations = 1, contact_hertz = 60.0,
@@ -372,6 +385,7 @@ impl PyWorld {
             world,
             dt: tumble_scene::DEFAULT_DT,
             duration: tumble_scene::DEFAULT_DURATION,
+            callbacks: None,
         }))
     }
 
@@ -386,6 +400,7 @@ impl PyWorld {
             world: s.world,
             dt: s.dt,
             duration: s.duration,
+            callbacks: None,
         }))
     }
 
@@ -397,6 +412,7 @@ impl PyWorld {
             world: s.world,
             dt: s.dt,
             duration: s.duration,
+            callbacks: None,
         }))
     }
 
@@ -635,13 +651,12 @@ impl PyWorld {
     #[pyo3(signature = (dt, steps = 1))]
     fn step(&self, py: Python<'_>, dt: f64, steps: u64) -> PyResult<()> {
         let mut g = self.lock()?;
-        let world = &mut g.world;
         let dt = real(dt);
         // Releasing and retaking the interpreter lock costs about what stepping an empty
         // world does, so a short step keeps it; counting an empty world as one body, so
         // that many steps of it (long, however cheap each) let other threads run.
-        let release = (world.body_count().max(1) as u64).saturating_mul(steps) >= 64;
-        crate::steps::run(py, world, steps, release, |_| dt, |_, _| ())?;
+        let release = (g.world.body_count().max(1) as u64).saturating_mul(steps) >= 64;
+        crate::steps::run(py, &mut g, steps, release, |_| dt, |_, _| ())?;
         Ok(())
     }
 

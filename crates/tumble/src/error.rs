@@ -39,6 +39,28 @@ pub enum Error {
         .0.limit
     )]
     TooManyContacts(Box<TooManyContacts>),
+    /// A force callback stopped the step ([`ForceContext::fail`]); the step was undone,
+    /// the world is as before it.
+    ///
+    /// [`ForceContext::fail`]: crate::dynamics::force::ForceContext::fail
+    #[error(
+        "step {} (t = {} s): force callback: {}",
+        .0.step,
+        crate::limits::short(.0.time),
+        .0.reason
+    )]
+    CallbackFailed(Box<CallbackFailed>),
+}
+
+/// Which step a force callback stopped, and the callback's reason.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CallbackFailed {
+    /// The number of the failed step (the world had taken `step - 1`).
+    pub step: u64,
+    /// Simulated time the failed step would have reached (s).
+    pub time: crate::math::Real,
+    /// What the callback said (the first callback to fail in the step).
+    pub reason: String,
 }
 
 /// Which step ran out of contact capacity, and the limit it reached.
@@ -117,7 +139,8 @@ impl Error {
                 field: join(field),
                 id,
             },
-            failed @ (Error::Unstable(_) | Error::TooManyContacts(_)) => failed,
+            failed
+            @ (Error::Unstable(_) | Error::TooManyContacts(_) | Error::CallbackFailed(_)) => failed,
         }
     }
 
@@ -125,14 +148,17 @@ impl Error {
     pub fn field(&self) -> &str {
         match self {
             Error::InvalidField { field, .. } | Error::UnknownBody { field, .. } => field,
-            Error::Unstable(_) => "",
+            Error::Unstable(_) | Error::CallbackFailed(_) => "",
             Error::TooManyContacts(_) => "max_contacts",
         }
     }
 
     /// Whether this is a step that failed (and was undone) rather than refused input.
     pub fn is_step_failure(&self) -> bool {
-        matches!(self, Error::Unstable(_) | Error::TooManyContacts(_))
+        matches!(
+            self,
+            Error::Unstable(_) | Error::TooManyContacts(_) | Error::CallbackFailed(_)
+        )
     }
 }
 

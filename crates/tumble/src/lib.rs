@@ -37,7 +37,8 @@ pub use collision::contact::{Contact, ContactEvent, ContactEventKind};
 pub use diagnostics::Diagnostics;
 pub use error::{Error, Result};
 pub use force::{
-    AppliedForce, Drag, Force, ForceCallback, ForceContext, Spring, SpringEnd, Wrench,
+    AppliedForce, Drag, EvaluatedState, Force, ForceCallback, ForceContext, Spring, SpringEnd,
+    Wrench,
 };
 pub use geometry::{Aabb, Pose, Ray, RayHit};
 pub use hooks::{ContactMaterial, ContactModification, ContactPair};

@@ -214,6 +214,65 @@ fn an_undone_step_leaves_the_world_exactly_as_before() {
     assert!(poisoned >= 6, "{poisoned}");
 }
 
+/// `busy_scene` with a force callback that counts its calls and, when `fail_at` holds a
+/// call number, stops the step at that call (as a Python exception does).
+fn failing_scene(calls: Arc<AtomicUsize>, fail_at: Arc<AtomicUsize>) -> World {
+    let mut w = busy_scene();
+    w.add_force_callback(Box::new(move |ctx: &mut ForceContext<'_>| {
+        let n = calls.fetch_add(1, Ordering::Relaxed) + 1;
+        if n == fail_at.load(Ordering::Relaxed) {
+            ctx.fail(format!("call {n}"));
+        }
+    }));
+    w
+}
+
+#[test]
+fn a_step_a_callback_fails_is_undone_and_calls_nothing_more() {
+    // The callback fails at its k-th call, in the integrator's stage (the free ball,
+    // Störmer–Verlet: one call) or in the solver's substeps (stack and pendulum):
+    // the step is undone bit for bit, no call follows the failing one, and from then on
+    // the world agrees with one that never failed, contacts, joints and memory included.
+    let dt = 1.0 / 60.0;
+    let (calls, fail_at) = (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)));
+    let mut a = failing_scene(calls.clone(), fail_at.clone());
+    let unused = Arc::new(AtomicUsize::new(0));
+    let mut b = failing_scene(Arc::new(AtomicUsize::new(0)), unused);
+    for n in 0..120 {
+        if n % 13 == 4 {
+            let start = calls.load(Ordering::Relaxed);
+            // The step's 1st to 4th call: while the free ball falls, the 1st is the
+            // integrator's; the swinging pendulum keeps the solver's 4 substeps going.
+            let k = start + 1 + n % 4;
+            fail_at.store(k, Ordering::Relaxed);
+            let (before, time, steps) = (a.state_hash(), a.time(), a.step_count());
+            let e = a.step(dt).unwrap_err();
+            assert!(e.is_step_failure());
+            assert_eq!(
+                e.to_string(),
+                format!(
+                    "step {} (t = {} s): force callback: call {k}",
+                    steps + 1,
+                    tumble::limits::short(time + dt)
+                )
+            );
+            assert_eq!(
+                calls.load(Ordering::Relaxed),
+                k,
+                "step {n}: a call after the failure"
+            );
+            assert_eq!(
+                (a.state_hash(), a.time(), a.step_count()),
+                (before, time, steps)
+            );
+        }
+        a.step(dt).unwrap();
+        b.step(dt).unwrap();
+        assert_eq!(a.state_hash(), b.state_hash(), "step {n}");
+        assert_eq!(a.contact_events(), b.contact_events(), "step {n}");
+    }
+}
+
 #[test]
 fn values_that_can_only_overflow_are_refused_with_the_limit() {
     let mut w = World::new(&WorldDef::default());

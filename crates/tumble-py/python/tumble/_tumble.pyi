@@ -1,7 +1,7 @@
 """Type stubs of the extension module behind `import tumble` (crates/tumble-py/src)."""
 
 from os import PathLike
-from typing import Literal, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Literal, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -96,6 +96,36 @@ class HeightField(Shape):
     """Terrain from a 2-D array of heights (rows along z, columns along x), scaled by [sx, sy, sz]. Static only."""
 
     def __init__(self, heights: npt.ArrayLike, scale: Optional[Vec3Like] = None) -> None: ...
+
+class ForceContext:
+    """What a force callback (``World.add_force_callback``) is called with: the state of
+    every body at the force evaluation being made, and where forces for it go. Bodies
+    are ``Body`` handles (fastest) or names. Valid only inside the call it was passed to
+    (RuntimeError after)."""
+
+    @property
+    def time(self) -> float:
+        """Simulated time of the state being evaluated (s)."""
+    def position(self, body: BodyLike) -> F64Array:
+        """World position of the body frame's origin (m), (3,)."""
+    def center_of_mass(self, body: BodyLike) -> F64Array:
+        """World position of the centre of mass (m), (3,)."""
+    def orientation(self, body: BodyLike) -> F64Array:
+        """Orientation [x, y, z, w], body frame to world."""
+    def velocity(self, body: BodyLike) -> F64Array:
+        """Velocity of the centre of mass (m/s, world frame), (3,)."""
+    def angular_velocity(self, body: BodyLike) -> F64Array:
+        """Angular velocity (rad/s, world frame), (3,)."""
+    def mass(self, body: BodyLike) -> float:
+        """Mass (kg)."""
+    def add_force(self, body: BodyLike, force: Vec3Like, point: Optional[Vec3Like] = None) -> None:
+        """Adds `force` (N, world frame) at `point` (m, body frame; default the centre of
+        mass) for this evaluation; off the centre it also adds r × F."""
+    def add_torque(self, body: BodyLike, torque: Vec3Like) -> None:
+        """Adds `torque` (N·m, world frame) for this evaluation."""
+
+ForceCallback = Callable[[ForceContext], Any]
+Controller = Callable[["World", float], Any]
 
 class Body:
     """A handle on a body; properties read the live state, eleven are assignable."""
@@ -516,6 +546,12 @@ class World:
     ) -> int:
         """A constant force at a body point and a constant torque; returns its id."""
     def remove_force(self, id: int) -> bool: ...
+    def add_force_callback(self, callback: ForceCallback) -> None:
+        """Calls `callback(ctx)` at every force evaluation (per step: once with the Euler
+        methods and Störmer–Verlet, twice with midpoint and velocity Verlet, four times
+        with RK4; once per solver substep for bodies in contact or joined, once more
+        when a joined body touches nothing). An exception in it stops the step, leaves
+        the world as before that step and is raised by step/simulate. Wakes every body."""
     def add_joint(
         self,
         kind: Literal["ball", "hinge", "slider", "fixed", "distance"],
@@ -557,12 +593,15 @@ class World:
         steps: Optional[int] = None,
         every: int = 1,
         diagnostics: bool = False,
+        controller: Optional[Controller] = None,
     ) -> Trajectory:
         """Runs in Rust with the interpreter released and returns the recorded trajectory.
 
         A recording larger than the machine's memory is refused (ValueError) before the run;
         Ctrl-C stops it between steps (KeyboardInterrupt); an unstable step raises
-        SimulationError, whose ``trajectory`` is the run up to the last good step."""
+        SimulationError, whose ``trajectory`` is the run up to the last good step.
+        ``controller(world, t)`` is called before every step with this world and the
+        step's start time (s); its exception stops the run before that step, raised as is."""
     @property
     def positions(self) -> F64Array:
         """(N, 3) body-frame origins (m); assignable."""

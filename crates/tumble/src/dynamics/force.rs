@@ -89,7 +89,9 @@ pub enum Force {
 }
 
 impl Force {
-    pub(crate) fn validate(&self) -> Result<()> {
+    /// Checks the element's values (not its bodies): the rule `World::add_force` applies,
+    /// its fields named as the element's (`force: must be finite numbers`).
+    pub fn validate(&self) -> Result<()> {
         match self {
             Force::Spring(s) => {
                 check::vec3_at_most("anchor", s.anchor, MAX_COORDINATE, "m")?;
@@ -132,20 +134,81 @@ impl Force {
     }
 }
 
-/// A user force: called at every force evaluation (several times per step for
-/// multi-stage integrators) with the state being evaluated.
+/// A user force: called at every force evaluation with the state being evaluated.
+///
+/// How often that is per step: bodies touching nothing advance with the world's
+/// integrator, which evaluates the forces once (explicit, symplectic and implicit Euler,
+/// Störmer–Verlet), twice (midpoint, velocity Verlet) or four times (RK4) a step; bodies
+/// in contact or joined go through the solver, once per substep (n + 1 times for n
+/// substeps when a joined body touches nothing: its kick is split around the drift).
+/// A world with both kinds of body runs both, and every call sees every body (forces
+/// on bodies the evaluation does not advance are ignored). A callback can stop the
+/// step with [`ForceContext::fail`].
 pub type ForceCallback = Box<dyn FnMut(&mut ForceContext<'_>) + Send>;
 
 /// What a [`ForceCallback`] sees and where it writes.
 pub struct ForceContext<'a> {
     pub(crate) time: Real,
     pub(crate) bodies: &'a [Body],
+    pub(crate) ids: &'a [BodyId],
     pub(crate) motions: &'a [Motion],
     pub(crate) lookup: &'a dyn Fn(BodyId) -> Option<usize>,
     pub(crate) out: &'a mut [Wrench],
+    pub(crate) failure: &'a mut Option<String>,
+}
+
+/// One body's state as a force evaluation sees it ([`ForceContext::state_at`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EvaluatedState {
+    /// World position of the body frame's origin (m).
+    pub position: Vec3,
+    /// World position of the centre of mass (m).
+    pub center_of_mass: Vec3,
+    /// Orientation, body frame to world.
+    pub orientation: crate::math::Quat,
+    /// Velocity of the centre of mass (m/s).
+    pub velocity: Vec3,
+    /// Angular velocity, world frame (rad/s).
+    pub angular_velocity: Vec3,
+    /// Mass (kg).
+    pub mass: Real,
 }
 
 impl ForceContext<'_> {
+    /// How many bodies the world has: [`ForceContext::state_at`] takes 0 to this − 1.
+    pub fn body_count(&self) -> usize {
+        self.motions.len()
+    }
+    /// Every body's handle, in creation order (the indices of [`ForceContext::state_at`]).
+    pub fn body_ids(&self) -> &[BodyId] {
+        self.ids
+    }
+    /// Body `index`'s name (creation order), if it has one.
+    pub fn name_at(&self, index: usize) -> Option<&str> {
+        self.bodies.get(index)?.name()
+    }
+    /// Body `index`'s state in this evaluation, bodies in creation order (the order of
+    /// `World::body_ids`), or `None` past the last. For reading many bodies at once.
+    pub fn state_at(&self, index: usize) -> Option<EvaluatedState> {
+        let (m, body) = (self.motions.get(index)?, self.bodies.get(index)?);
+        Some(EvaluatedState {
+            position: m.x - m.q * body.local_center,
+            center_of_mass: m.x,
+            orientation: m.q,
+            velocity: m.v,
+            angular_velocity: m.w,
+            mass: body.mass,
+        })
+    }
+    /// Stops the step: no callback is called again in it, the step is undone (the world
+    /// is left as it was before it) and `World::step` returns
+    /// [`Error::CallbackFailed`](crate::error::Error::CallbackFailed) with `reason`. Only
+    /// the first reason in a step is kept.
+    pub fn fail(&mut self, reason: impl Into<String>) {
+        if self.failure.is_none() {
+            *self.failure = Some(reason.into());
+        }
+    }
     /// Simulation time of the state being evaluated (s).
     pub fn time(&self) -> Real {
         self.time
@@ -179,6 +242,24 @@ impl ForceContext<'_> {
         match (self.lookup)(body) {
             Some(i) => {
                 let r = world_point - self.motions[i].x;
+                self.out[i].force += force;
+                self.out[i].torque += r.cross(force);
+                true
+            }
+            None => false,
+        }
+    }
+    /// Adds a force acting at `local_point` (body frame, m), as an [`AppliedForce`] with
+    /// that `point` does: it also adds the torque r × F. Returns false for an unknown body.
+    pub fn add_force_at_local_point(
+        &mut self,
+        body: BodyId,
+        force: Vec3,
+        local_point: Vec3,
+    ) -> bool {
+        match (self.lookup)(body) {
+            Some(i) => {
+                let r = self.motions[i].q * (local_point - self.bodies[i].local_center);
                 self.out[i].force += force;
                 self.out[i].torque += r.cross(force);
                 true

@@ -110,8 +110,12 @@ pub(crate) struct System<'a> {
     pub gravity: Vec3,
     pub forces: &'a [Force],
     pub bodies: &'a [Body],
+    /// Each body's handle, in the order of `bodies`.
+    pub ids: &'a [BodyId],
     pub lookup: &'a dyn Fn(BodyId) -> Option<usize>,
     pub callbacks: &'a mut [ForceCallback],
+    /// Set by the first callback that fails the step; no callback runs after it.
+    pub failure: &'a mut Option<String>,
 }
 
 impl System<'_> {
@@ -127,12 +131,19 @@ impl System<'_> {
             out,
         );
         for callback in self.callbacks.iter_mut() {
+            if self.failure.is_some() {
+                // The step will be undone: its forces no longer matter, and a callback
+                // that failed (a Python exception) must not be asked again.
+                break;
+            }
             let mut ctx = ForceContext {
                 time: t,
                 bodies: self.bodies,
+                ids: self.ids,
                 motions,
                 lookup: self.lookup,
                 out,
+                failure: &mut *self.failure,
             };
             callback(&mut ctx);
         }

@@ -62,9 +62,11 @@ impl World {
             .zip(self.forces.list.iter())
     }
 
-    /// Adds a user force function, evaluated with every other force.
+    /// Adds a user force function, evaluated with every other force (how often per step:
+    /// [`ForceCallback`]). It may push any body, so every body is woken.
     pub fn add_force_callback(&mut self, callback: ForceCallback) {
         self.forces.callbacks.push(callback);
+        self.wake_all();
     }
 
     /// Removes every force element attached to `body` (the body is being removed).

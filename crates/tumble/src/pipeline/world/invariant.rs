@@ -16,13 +16,15 @@
 //! contacts beside last step's and swaps back; what remains (the sleep state
 //! `wake_touched` changes, the joints' warm starts and broken flags, the integrator's
 //! memory, the kinematic targets taken) is copied before the stages run, about 30 bytes per body and the joint list.
-//! Force callbacks are the user's code and are not undone.
+//! Force callbacks are the user's code and are not undone. A callback that stops the
+//! step (`ForceContext::fail`, how Python's exceptions leave a callback) has the step
+//! undone the same way, by `check_callbacks` right after the stage that called it.
 
 use crate::dynamics::body::{Body, BodyKind};
 use crate::dynamics::integrate::IntegratorMemory;
 use crate::dynamics::joint::Joint;
 use crate::dynamics::solver::{SolverBodies, StepTime};
-use crate::error::{Error, Result, TooManyContacts, Unstable};
+use crate::error::{CallbackFailed, Error, Result, TooManyContacts, Unstable};
 use crate::limits::{short, SpeedLimits, MAX_COORDINATE};
 use crate::math::{vec3_is_finite, Quat, Real, Vec3};
 use crate::pipeline::world::World;
@@ -83,6 +85,21 @@ impl World {
             step: self.clock.steps + 1,
             time: time.t + time.dt,
             limit: self.settings.contacts.per_step,
+        })))
+    }
+
+    /// Fails the step if a force callback stopped it (`ForceContext::fail`): the
+    /// integrator or the solver ran on without the callbacks after that, so the step's
+    /// result is not the forces' and is thrown away.
+    pub(super) fn check_callbacks(&mut self, time: &StepTime) -> Result<()> {
+        let Some(reason) = self.forces.failure.take() else {
+            return Ok(());
+        };
+        self.undo();
+        Err(Error::CallbackFailed(Box::new(CallbackFailed {
+            step: self.clock.steps + 1,
+            time: time.t + time.dt,
+            reason,
         })))
     }
 

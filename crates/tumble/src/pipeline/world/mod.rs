@@ -184,6 +184,9 @@ pub(crate) struct ForceStore {
     pub list: Vec<Force>,
     pub handles: Handles<ForceId>,
     pub callbacks: Vec<ForceCallback>,
+    /// The reason a callback gave for stopping the current step (`ForceContext::fail`);
+    /// `None` between steps (the step's check takes it).
+    pub failure: Option<String>,
 }
 
 /// Joints in creation order with their handles (see `joints.rs`), and what each

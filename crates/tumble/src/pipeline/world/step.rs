@@ -14,6 +14,10 @@
 //! gather               bodies, contacts, joint links       context: solved mask, solver bodies
 //! find_ghosts          bodies, contacts                    context: ghost mask
 //! integrate_free       forces, bodies; context             solver bodies touching nothing
+//! check_callbacks      forces' failure                     nothing; after a force callback
+//!                                                          failed (after integrate_free and
+//!                                                          after solve), undoes the step
+//!                                                          and returns the error
 //! solve                forces, joints, contacts; context   solver bodies in contact or joined,
 //!                                                          contact impulses, joint reactions
 //! move_kinematic       context                             kinematic solver bodies
@@ -82,9 +86,11 @@ impl World {
     ///
     /// A step whose result has a non-finite value or a speed beyond the world's limits is
     /// undone, leaving the world as it was, and returns [`Error::Unstable`] naming the
-    /// step, the body and the quantity (see `invariant.rs`).
+    /// step, the body and the quantity (see `invariant.rs`); so is a step a force callback
+    /// stops ([`Error::CallbackFailed`]).
     ///
     /// [`Error::Unstable`]: crate::error::Error::Unstable
+    /// [`Error::CallbackFailed`]: crate::error::Error::CallbackFailed
     pub fn step(&mut self, dt: Real) -> Result<()> {
         check::positive("dt", dt)?;
         // A small world steps on the calling thread: handing a step to the pool and back
@@ -113,7 +119,9 @@ impl World {
         self.gather();
         self.find_ghosts(&time);
         self.integrate_free(&time);
+        self.check_callbacks(&time)?;
         self.solve(&time);
+        self.check_callbacks(&time)?;
         self.move_kinematic(&time);
         self.sweep_fast();
         self.check_result(&time)?;
@@ -189,7 +197,12 @@ impl World {
             .extend((0..bodies.len()).map(|i| ctx.bodies.motion(i)));
         let handles = &self.bodies.handles;
         let find = |id: BodyId| handles.dense(id);
-        let mut system = system(&self.settings, &mut self.forces, bodies, &find);
+        let mut system = system(
+            &self.settings,
+            &mut self.forces,
+            (bodies, handles.ids()),
+            &find,
+        );
         integrate::advance(
             self.settings.integrator,
             &mut system,
@@ -218,7 +231,12 @@ impl World {
         }
         let handles = &self.bodies.handles;
         let find = |id: BodyId| handles.dense(id);
-        let mut system = system(&self.settings, &mut self.forces, &self.bodies.list, &find);
+        let mut system = system(
+            &self.settings,
+            &mut self.forces,
+            (&self.bodies.list, handles.ids()),
+            &find,
+        );
         let input = StepInput {
             system: &mut system,
             settings: &self.settings.solver,
@@ -312,14 +330,16 @@ impl World {
 fn system<'a>(
     settings: &crate::pipeline::world::Settings,
     forces: &'a mut crate::pipeline::world::ForceStore,
-    bodies: &'a [crate::dynamics::body::Body],
+    (bodies, ids): (&'a [crate::dynamics::body::Body], &'a [BodyId]),
     find: &'a dyn Fn(BodyId) -> Option<usize>,
 ) -> System<'a> {
     System {
         gravity: settings.gravity,
         forces: &forces.list,
         bodies,
+        ids,
         lookup: find,
         callbacks: &mut forces.callbacks,
+        failure: &mut forces.failure,
     }
 }
