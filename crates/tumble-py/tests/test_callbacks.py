@@ -267,11 +267,11 @@ def test_bad_values_and_misuse_inside_a_callback_stop_the_step_with_their_error(
 
 
 def grid(threads, pull):
-    """300 free balls (enough for a step to go to the world's threads) pulled towards the
-    origin by a callback."""
+    """1,200 free balls (a step of fewer than 1,000 bodies stays on the caller's thread)
+    pulled towards the origin by a callback."""
     world = tumble.World(gravity=(0, 0, 0), threads=threads, integrator="rk4")
     balls = [world.add_body(tumble.Sphere(0.1), mass=1.0 + i % 3, position=(i % 20, i // 20, 0))
-             for i in range(300)]
+             for i in range(1200)]
     world.add_force_callback(pull(balls))
     return world
 

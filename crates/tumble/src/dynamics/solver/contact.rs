@@ -22,6 +22,7 @@ use crate::collision::contact::Contact;
 use crate::collision::geometry::Pose;
 use crate::collision::narrow_phase::{ContactPoint, Manifold};
 use crate::math::{orthonormal_basis, Real, Vec3};
+use crate::threads::Par;
 
 /// How position error turns into velocity in one substep.
 #[derive(Debug, Clone, Copy)]
@@ -157,16 +158,16 @@ impl Points {
     /// Groups the constraints (in the solver's order) for the wide passes; no group
     /// spans either of `splits`, where the passes of the heavy islands and the tall
     /// stacks start.
-    pub fn group_lanes(&mut self, constraints: &[ContactConstraint], splits: [usize; 2]) {
+    pub fn group_lanes(&mut self, constraints: &[ContactConstraint], splits: [usize; 2], par: Par) {
         let angular = !self.angular.is_empty();
         self.lanes
-            .build(constraints, (splits, angular), &self.hot, &self.cold);
+            .build(constraints, (splits, angular), (&self.hot, &self.cold), par);
     }
 
     /// Brings the grouped points' impulses and totals back from the lanes.
-    pub fn save_lanes(&mut self, constraints: &[ContactConstraint]) {
+    pub fn save_lanes(&mut self, constraints: &[ContactConstraint], par: Par) {
         self.lanes
-            .write_back(constraints, &mut self.hot, &mut self.cold);
+            .write_back(constraints, (&mut self.hot, &mut self.cold), par);
     }
 }
 

@@ -50,7 +50,7 @@ const MIN_LANES: usize = 2;
 const GROUPS_A_PIECE: usize = 32;
 
 /// Up to [`LANES`] consecutive constraints of one colour.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 struct Group {
     /// The group's first constraint in the solver's order, and how many lanes are used.
     first: usize,
@@ -93,11 +93,11 @@ pub(crate) struct ContactLanes {
 }
 
 impl ContactLanes {
+    /// Forgets the groups. The slot buffers keep their length: a group reaches only its
+    /// own slots, and `fill` blanks them in parallel rather than a serial resize from zero
+    /// every step.
     pub fn clear(&mut self) {
         self.groups.clear();
-        self.slots.clear();
-        self.masks.clear();
-        self.cold.clear();
         self.unsaved = false;
         self.runs.clear();
         self.stamp.fill(0);
@@ -107,18 +107,21 @@ impl ContactLanes {
     /// Groups `constraints` (in the solver's order) and copies their points into slots;
     /// groups stay between the `splits` (the passes of the heavy islands and the tall
     /// stacks start there, see `Solver::passes`); `angular` says whether any constraint has angular rows,
-    /// which stay scalar. No groups in scalar mode.
+    /// which stay scalar. No groups in scalar mode. The groups are planned here and
+    /// filled on the step's team (the copy was 5 % of the rain's step on one thread).
     pub fn build(
         &mut self,
         constraints: &[ContactConstraint],
         ([heavy, tall], angular): ([usize; 2], bool),
-        hot: &[Point],
-        cold: &[PointCold],
+        (hot, cold): (&[Point], &[PointCold]),
+        par: Par,
     ) {
         self.clear();
         if lane_mode() == LaneMode::Scalar {
             return;
         }
+        let mut runs = Vec::new();
+        let mut slots = 0;
         for part in [0..heavy, heavy..tall, tall..constraints.len()] {
             let mut start = part.start;
             while start < part.end {
@@ -133,14 +136,70 @@ impl ContactLanes {
                     let lanes = group_size(&constraints[first..end], angular);
                     if lanes >= MIN_LANES {
                         let cs = &constraints[first..first + lanes];
-                        self.push_group(cs, first, hot, cold);
+                        let count = cs.iter().map(|c| c.range().len()).max().unwrap_or(0);
+                        self.groups.push(Group::planned(first, lanes, slots, count));
+                        slots += count;
                     }
                     first += lanes.max(1);
                 }
-                self.add_run(run_start..self.groups.len());
+                runs.push(run_start..self.groups.len());
                 start = end;
             }
         }
+        self.fill(constraints, (hot, cold), slots, par);
+        for run in runs {
+            self.add_run(run);
+        }
+    }
+
+    /// Fills the planned groups and their `slots` slots from the constraints' points, in
+    /// pieces of consecutive groups on the step's team. The slot buffers only grow: each
+    /// piece blanks its own slots, so no thread writes a slot twice.
+    fn fill(
+        &mut self,
+        constraints: &[ContactConstraint],
+        (hot, cold): (&[Point], &[PointCold]),
+        slots: usize,
+        par: Par,
+    ) {
+        if self.slots.len() < slots {
+            self.slots.resize(slots, self.blank);
+            self.masks.resize(slots, Masks::default());
+            self.cold.resize(slots, Sums::default());
+        }
+        let n = self.groups.len();
+        let size = n.div_ceil(par.pieces(n, GROUPS_A_PIECE)).max(1);
+        let blank = self.blank;
+        let groups = Parts::new(&mut self.groups);
+        let slot_parts = Parts::new(&mut self.slots[..slots]);
+        let mask_parts = Parts::new(&mut self.masks[..slots]);
+        let sum_parts = Parts::new(&mut self.cold[..slots]);
+        crate::team::pieces(par.threads, n.div_ceil(size), &|i| {
+            let range = i * size..((i + 1) * size).min(n);
+            // SAFETY: piece i takes groups i·size.. alone, and the slots from its first
+            // group's slot0 to its last group's end: groups' slots are consecutive and
+            // disjoint (planned in order), so no two pieces' parts overlap.
+            let groups = unsafe { groups.part(range) };
+            let from = groups[0].slot0;
+            let to = groups.last().map_or(from, |g| g.slot0 + g.slots);
+            let (slots, masks, sums) = unsafe {
+                (
+                    slot_parts.part(from..to),
+                    mask_parts.part(from..to),
+                    sum_parts.part(from..to),
+                )
+            };
+            slots.fill(blank);
+            masks.fill(Masks::default());
+            sums.fill(Sums::default());
+            for g in groups {
+                let cs = &constraints[g.first..g.first + g.lanes];
+                let at = g.slot0 - from..g.slot0 - from + g.slots;
+                g.fill(cs);
+                let out = (&mut slots[at.clone()], &mut masks[at.clone()]);
+                fill_slots(cs, (hot, cold), out, &mut sums[at]);
+            }
+        });
     }
 
     /// Keeps `run` (groups of one colour) for splitting over threads if it is long enough
@@ -180,15 +239,93 @@ impl ContactLanes {
         self.runs.push(run);
     }
 
-    fn push_group(
+    /// Copies the impulses, the approach velocities and the totals of the grouped points
+    /// back into the scalar points, for the end-of-step passes and the contacts; in
+    /// pieces of consecutive groups on the step's team (a group's points are the
+    /// consecutive points of its consecutive constraints).
+    pub fn write_back(
         &mut self,
-        cs: &[ContactConstraint],
-        first: usize,
-        hot: &[Point],
-        cold: &[PointCold],
+        constraints: &[ContactConstraint],
+        (hot, cold): (&mut [Point], &mut [PointCold]),
+        par: Par,
     ) {
-        // Unused lanes repeat lane 0's constraint, which they only read; missing points
-        // stay zeros, and their lanes are masked out.
+        if !std::mem::take(&mut self.unsaved) {
+            return;
+        }
+        let (groups, n) = (&self.groups, self.groups.len());
+        let size = n.div_ceil(par.pieces(n, GROUPS_A_PIECE)).max(1);
+        let (hot, cold) = (Parts::new(hot), Parts::new(cold));
+        let points = |g: &Group| {
+            let first = constraints[g.first].range().start;
+            first..constraints[g.first + g.lanes - 1].range().end
+        };
+        crate::team::pieces(par.threads, n.div_ceil(size), &|i| {
+            let groups = &groups[i * size..((i + 1) * size).min(n)];
+            let base = points(&groups[0]).start;
+            let end = points(&groups[groups.len() - 1]).end;
+            // SAFETY: the groups' point ranges are disjoint and in order (the groups'
+            // constraints are consecutive, in the order their points were laid), so
+            // pieces of consecutive groups own disjoint ranges of points.
+            let (hot, cold) = unsafe { (hot.part(base..end), cold.part(base..end)) };
+            for g in groups {
+                let lanes = constraints[g.first..g.first + g.lanes].iter().enumerate();
+                for (l, c) in lanes {
+                    for (j, i) in c.range().enumerate() {
+                        let (s, sc) = (&self.slots[g.slot0 + j], &self.cold[g.slot0 + j]);
+                        s.read_lane(l, sc, (&mut hot[i - base], &mut cold[i - base]));
+                    }
+                }
+            }
+        });
+    }
+}
+
+/// Copies the points of a group's constraints `cs` into its slots: lane l of slot j is
+/// point j of constraint l; missing points stay blank, their lanes masked out.
+fn fill_slots(
+    cs: &[ContactConstraint],
+    (hot, cold): (&[Point], &[PointCold]),
+    (slots, masks): (&mut [Point<Lanes>], &mut [Masks<Mask>]),
+    sums: &mut [Sums<Lanes>],
+) {
+    for (l, c) in cs.iter().enumerate() {
+        for (j, i) in c.range().enumerate() {
+            slots[j].set_lane(l, &hot[i]);
+            masks[j].set_lane(l, c.moves());
+            sums[j].set_lane(l, &cold[i].sums);
+        }
+    }
+}
+
+impl Point<Lanes> {
+    /// Lane `l`'s impulses, and `sums`' approach velocity and totals, into the scalar
+    /// point.
+    fn read_lane(&self, l: usize, sums: &Sums<Lanes>, (p, pc): (&mut Point, &mut PointCold)) {
+        p.normal_impulse = self.normal_impulse.0[l];
+        p.tangent_impulse = [self.tangent_impulse[0].0[l], self.tangent_impulse[1].0[l]];
+        p.max_normal_impulse = self.max_normal_impulse.0[l];
+        pc.sums.approach_velocity = sums.approach_velocity.0[l];
+        pc.sums.total_normal = sums.total_normal.0[l];
+        pc.sums.total_tangent = [sums.total_tangent[0].0[l], sums.total_tangent[1].0[l]];
+    }
+}
+
+impl Group {
+    /// A group of `lanes` constraints from `first` with `slots` slots from `slot0`, to
+    /// be filled by [`Group::fill`].
+    fn planned(first: usize, lanes: usize, slot0: usize, slots: usize) -> Group {
+        Group {
+            first,
+            lanes,
+            slot0,
+            slots,
+            ..Group::default()
+        }
+    }
+
+    /// The lanes' bodies, moving masks and frames from the group's constraints `cs`.
+    fn fill(&mut self, cs: &[ContactConstraint]) {
+        // Unused lanes repeat lane 0's constraint, which they only read.
         let lane = |l: usize| &cs[if l < cs.len() { l } else { 0 }];
         let vec =
             |f: &dyn Fn(&ContactConstraint) -> crate::math::Vec3| Lanes3::from_fn(|l| f(lane(l)));
@@ -198,75 +335,28 @@ impl ContactLanes {
                 .enumerate()
                 .fold(0u32, |m, (l, on)| m | (u32::from(on) << l))
         };
-        let slot0 = self.slots.len();
-        let slots = cs.iter().map(|c| c.range().len()).max().unwrap_or(0);
-        let group = Group {
-            first,
-            lanes: cs.len(),
-            a: std::array::from_fn(|l| lane(l).bodies().0),
-            b: std::array::from_fn(|l| lane(l).bodies().1),
-            moves_a: moves(0),
-            moves_b: moves(1),
-            frame: Frame {
-                normal: vec(&|c| c.normal()),
-                tangents: [vec(&|c| c.tangents()[0]), vec(&|c| c.tangents()[1])],
-                push_a: std::array::from_fn(|k| vec(&|c| c.pushes().0[k])),
-                push_b: std::array::from_fn(|k| vec(&|c| c.pushes().1[k])),
-                friction: Lanes::from_fn(|l| lane(l).friction()),
-                round: [
-                    Lanes::from_fn(|l| lane(l).round()[0]),
-                    Lanes::from_fn(|l| lane(l).round()[1]),
-                ],
-                impulse_scale: Lanes::from_fn(|l| lane(l).frame.impulse_scale),
-                surface: [
-                    Lanes::from_fn(|l| lane(l).frame.surface[0]),
-                    Lanes::from_fn(|l| lane(l).frame.surface[1]),
-                ],
-                anchor: Lanes::from_fn(|l| lane(l).frame.anchor),
-            },
-            round: cs.iter().any(|c| c.has_round()),
-            slot0,
-            slots,
+        self.a = std::array::from_fn(|l| lane(l).bodies().0);
+        self.b = std::array::from_fn(|l| lane(l).bodies().1);
+        self.moves_a = moves(0);
+        self.moves_b = moves(1);
+        self.frame = Frame {
+            normal: vec(&|c| c.normal()),
+            tangents: [vec(&|c| c.tangents()[0]), vec(&|c| c.tangents()[1])],
+            push_a: std::array::from_fn(|k| vec(&|c| c.pushes().0[k])),
+            push_b: std::array::from_fn(|k| vec(&|c| c.pushes().1[k])),
+            friction: Lanes::from_fn(|l| lane(l).friction()),
+            round: [
+                Lanes::from_fn(|l| lane(l).round()[0]),
+                Lanes::from_fn(|l| lane(l).round()[1]),
+            ],
+            impulse_scale: Lanes::from_fn(|l| lane(l).frame.impulse_scale),
+            surface: [
+                Lanes::from_fn(|l| lane(l).frame.surface[0]),
+                Lanes::from_fn(|l| lane(l).frame.surface[1]),
+            ],
+            anchor: Lanes::from_fn(|l| lane(l).frame.anchor),
         };
-        self.slots.resize(slot0 + slots, self.blank);
-        self.masks.resize(slot0 + slots, Masks::default());
-        self.cold.resize(slot0 + slots, Sums::default());
-        for (l, c) in cs.iter().enumerate() {
-            for (j, i) in c.range().enumerate() {
-                self.slots[slot0 + j].set_lane(l, &hot[i]);
-                self.masks[slot0 + j].set_lane(l, c.moves());
-                self.cold[slot0 + j].set_lane(l, &cold[i].sums);
-            }
-        }
-        self.groups.push(group);
-    }
-
-    /// Copies the impulses, the approach velocities and the totals of the grouped points
-    /// back into the scalar points, for the end-of-step passes and the contacts.
-    pub fn write_back(
-        &mut self,
-        constraints: &[ContactConstraint],
-        hot: &mut [Point],
-        cold: &mut [PointCold],
-    ) {
-        if !std::mem::take(&mut self.unsaved) {
-            return;
-        }
-        for g in &self.groups {
-            let lanes = constraints[g.first..g.first + g.lanes].iter().enumerate();
-            for (l, c) in lanes {
-                for (j, i) in c.range().enumerate() {
-                    let (s, sc) = (&self.slots[g.slot0 + j], &self.cold[g.slot0 + j]);
-                    let (p, pc) = (&mut hot[i], &mut cold[i]);
-                    p.normal_impulse = s.normal_impulse.0[l];
-                    p.tangent_impulse = [s.tangent_impulse[0].0[l], s.tangent_impulse[1].0[l]];
-                    p.max_normal_impulse = s.max_normal_impulse.0[l];
-                    pc.sums.approach_velocity = sc.approach_velocity.0[l];
-                    pc.sums.total_normal = sc.total_normal.0[l];
-                    pc.sums.total_tangent = [sc.total_tangent[0].0[l], sc.total_tangent[1].0[l]];
-                }
-            }
-        }
+        self.round = cs.iter().any(|c| c.has_round());
     }
 }
 

@@ -27,7 +27,8 @@ pub(crate) const TOLERANCE: Real = 1e-4;
 /// for the replay and a few times n for the velocities to converge.
 const MAX_PASSES: usize = 64;
 
-/// Resolves the step's bounces; `start` holds the velocities of the step's start.
+/// Resolves the step's bounces; `start` holds the velocities of the step's start. The
+/// wide passes' impulses must be back in the points (`Points::save_lanes`).
 pub(crate) fn resolve_bounces(
     constraints: &[ContactConstraint],
     points: &mut Points,
@@ -36,9 +37,6 @@ pub(crate) fn resolve_bounces(
     moves: &[bool],
     threshold: Real,
 ) {
-    // The wide passes' impulses go back to the points first; this pass and the contacts'
-    // impulses read them there.
-    points.save_lanes(constraints);
     let cluster = bounce_cluster(constraints, points, moves, threshold);
     if cluster.is_empty() {
         return;
