@@ -518,17 +518,8 @@ impl Solver {
             ));
             let k = self.constraints.len() - 1;
             self.fit_to_part(k, part, c.manifold.fine, &spring);
-            if c.manifold.overlap == Overlap::Clear {
-                continue;
-            }
-            for (j, mp) in c.manifold.points().iter().enumerate() {
-                let start_velocity = self.points.cold[first + j].start_velocity;
-                let p = &mut self.points.hot[first + j];
-                let at = (mp.separation, start_velocity);
-                if let Some(deep) = overlap::Deep::find((k, first + j), at, p, &allow) {
-                    p.separation = -deep.depth;
-                    self.deep.push(deep);
-                }
+            if c.manifold.overlap != Overlap::Clear {
+                self.find_deep(c, (k, first), &allow);
             }
         }
         self.points.group_lanes(
@@ -536,6 +527,20 @@ impl Solver {
             [self.heavy_contacts, self.tall_contacts],
             self.par,
         );
+    }
+
+    /// The points of constraint `k` (contact `c`, its points from `first`) deeper than
+    /// `allow`, kept for the push apart at the end of the step.
+    fn find_deep(&mut self, c: &Contact, (k, first): (usize, usize), allow: &overlap::Allowance) {
+        for (j, mp) in c.manifold.points().iter().enumerate() {
+            let start_velocity = self.points.cold[first + j].start_velocity;
+            let p = &mut self.points.hot[first + j];
+            let at = (mp.separation, start_velocity);
+            if let Some(deep) = overlap::Deep::find((k, first + j), at, p, allow) {
+                p.separation = -deep.depth;
+                self.deep.push(deep);
+            }
+        }
     }
 
     /// Fits constraint `k` to its `part`'s passes: warm starts made per substep of the
