@@ -113,8 +113,8 @@ impl Format {
 /// not increase); a step that fails ends the run, and the file keeps it up to the last
 /// good step (exit 1), as `tumble run` does.
 pub fn export(args: &GltfArgs) -> Result<(), Failure> {
-    let format = Format::of(&args.out)?;
     let target = Target::file("out", &args.out)?;
+    let format = Format::of(&args.out)?;
     check_distinct(&[&target], &inputs(&scene_file(&args.scene)))?;
     let mut scene = tumble_scene::load(&args.scene)?;
     if let Some(n) = args.threads {
@@ -182,10 +182,15 @@ fn check_frames(plan: &RunPlan, every: u64, moving: usize) -> Result<(), SceneEr
         return Err(SceneError::new(
             "every",
             format!(
-                "{frames} keyframes of {moving} moving bodies are {bytes} bytes, more than \
-                 {MAX_KEYFRAME_BYTES}; keyframe fewer steps with a larger --every"
+                "{frames} keyframes of {moving} moving {} would take {bytes} bytes, more than \
+                 the {MAX_KEYFRAME_BYTES} allowed; keyframe fewer steps with a larger --every",
+                if moving == 1 { "body" } else { "bodies" }
             ),
         ));
+    }
+    if moving == 0 {
+        // No animation: the times are not written.
+        return Ok(());
     }
     let mut before: Option<(u64, f32)> = None;
     for k in recorded(plan, every) {
@@ -194,8 +199,8 @@ fn check_frames(plan: &RunPlan, every: u64, moving: usize) -> Result<(), SceneEr
             return Err(SceneError::new(
                 "every",
                 format!(
-                    "steps {j} and {k} fall at the same time in f32 ({s} s), which glTF's \
-                     animation times are; keyframe fewer steps with a larger --every"
+                    "steps {j} and {k} are both at {s} s in f32, glTF's float for animation \
+                     times; keyframe fewer steps with a larger --every"
                 ),
             ));
         }
@@ -211,10 +216,12 @@ fn f(x: Real) -> f32 {
 }
 
 /// Every recorded pose: times, and per body its translations and rotations (x, y, z, w)
-/// one frame after another.
+/// one frame after another; a static body's first only (it has no animation).
 struct Recording {
     times: Vec<f32>,
     poses: Vec<(Vec<f32>, Vec<f32>)>,
+    /// Whether each body is animated (not static).
+    moving: Vec<bool>,
     /// The farthest any body's surface came from the origin (m), for the planes' size.
     reach: f32,
     /// Each body's distance from its origin to the farthest point of its shape (m).
@@ -236,6 +243,10 @@ impl Recording {
         Recording {
             times: Vec::new(),
             poses: world.bodies().map(|_| (Vec::new(), Vec::new())).collect(),
+            moving: world
+                .bodies()
+                .map(|(_, b)| b.kind() != BodyKind::Static)
+                .collect(),
             reach: 0.0,
             radii,
         }
@@ -247,17 +258,21 @@ impl Recording {
         let t = f(time);
         if self.times.last().is_some_and(|last| t <= *last) {
             self.times.pop();
-            for (p, q) in &mut self.poses {
+            for ((p, q), _) in self.poses.iter_mut().zip(&self.moving).filter(|(_, m)| **m) {
                 p.truncate(p.len() - 3);
                 q.truncate(q.len() - 4);
             }
         }
+        let first = self.times.is_empty();
         self.times.push(t);
-        for (((_, body), (p, q)), radius) in world.bodies().zip(&mut self.poses).zip(&self.radii) {
+        let bodies = world.bodies().zip(&mut self.poses).zip(&self.moving);
+        for ((((_, body), (p, q)), moving), radius) in bodies.zip(&self.radii) {
             let (x, o) = (body.position(), body.orientation());
             let x = [f(x.x), f(x.y), f(x.z)];
-            p.extend(x);
-            q.extend([f(o.x), f(o.y), f(o.z), f(o.w)]);
+            if first || *moving {
+                p.extend(x);
+                q.extend([f(o.x), f(o.y), f(o.z), f(o.w)]);
+            }
             let r = x.iter().map(|c| c * c).sum::<f32>().sqrt() + radius;
             if r.is_finite() {
                 self.reach = self.reach.max(r);
