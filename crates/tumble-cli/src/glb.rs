@@ -7,8 +7,8 @@
 //!   chunk with zeros; the header's `length` is the whole file's, in a u32;
 //! - the buffer of a GLB has no `uri`, and its `byteLength` is the BIN data's length
 //!   before padding (at most 3 bytes less than the chunk);
-//! - every buffer view starts at a multiple of 4 (all data here is f32, so it does), and
-//!   an accessor's `count` × its element size fits its view exactly;
+//! - every buffer view starts at a multiple of 4 (all data here is f32 or u32, so it
+//!   does), and an accessor's `count` × its element size fills its view exactly;
 //! - accessors of vertex positions and of animation inputs carry `min` and `max` (this
 //!   writer gives every accessor its bounds), computed from the f32 values written.
 
@@ -23,8 +23,11 @@ const CHUNK_JSON: u32 = 0x4E4F_534A;
 const CHUNK_BIN: u32 = 0x004E_4942;
 /// `bufferView.target` of vertex attributes (ARRAY_BUFFER).
 pub const ARRAY_BUFFER: u32 = 34962;
-/// `accessor.componentType` FLOAT.
+/// `bufferView.target` of vertex indices (ELEMENT_ARRAY_BUFFER).
+const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+/// `accessor.componentType` FLOAT and UNSIGNED_INT.
 const FLOAT: u32 = 5126;
+const UNSIGNED_INT: u32 = 5125;
 
 /// The binary data of a document being built, with the buffer views and accessors that
 /// describe it.
@@ -42,7 +45,6 @@ impl Buffer {
     pub fn floats(&mut self, data: &[f32], kind: &str, target: Option<u32>) -> usize {
         let n = match kind {
             "SCALAR" => 1,
-            "VEC2" => 2,
             "VEC3" => 3,
             _ => 4,
         };
@@ -51,12 +53,6 @@ impl Buffer {
             "{kind}: {}",
             data.len()
         );
-        let offset = self.bytes.len();
-        self.bytes.extend(data.iter().flat_map(|x| x.to_le_bytes()));
-        let mut view = json!({"buffer": 0, "byteOffset": offset, "byteLength": data.len() * 4});
-        if let Some(target) = target {
-            view["target"] = json!(target);
-        }
         let mut min = vec![f32::INFINITY; n];
         let mut max = vec![f32::NEG_INFINITY; n];
         for element in data.chunks_exact(n) {
@@ -65,15 +61,53 @@ impl Buffer {
                 max[i] = max[i].max(*x);
             }
         }
-        self.views.push(view);
-        self.accessors.push(json!({
-            "bufferView": self.views.len() - 1,
+        let bytes = data.iter().flat_map(|x| x.to_le_bytes());
+        let accessor = json!({
             "componentType": FLOAT,
             "count": data.len() / n,
             "type": kind,
             "min": min,
             "max": max,
-        }));
+        });
+        self.push(bytes, target, accessor)
+    }
+
+    /// Appends vertex indices (u32, three per triangle) as their own buffer view and an
+    /// accessor; returns the accessor's index. `data` must not be empty.
+    pub fn indices(&mut self, data: &[u32]) -> usize {
+        let (min, max) = (data.iter().min(), data.iter().max());
+        let accessor = json!({
+            "componentType": UNSIGNED_INT,
+            "count": data.len(),
+            "type": "SCALAR",
+            "min": [min],
+            "max": [max],
+        });
+        let bytes = data.iter().flat_map(|i| i.to_le_bytes());
+        self.push(bytes, Some(ELEMENT_ARRAY_BUFFER), accessor)
+    }
+
+    /// `bytes` as a new buffer view, described by `accessor` (all but its view).
+    fn push(
+        &mut self,
+        bytes: impl Iterator<Item = u8>,
+        target: Option<u32>,
+        mut accessor: Value,
+    ) -> usize {
+        // Every element here is 4 bytes, so every view starts 4-byte aligned.
+        let offset = self.bytes.len();
+        self.bytes.extend(bytes);
+        let mut view = json!({
+            "buffer": 0,
+            "byteOffset": offset,
+            "byteLength": self.bytes.len() - offset,
+        });
+        if let Some(target) = target {
+            view["target"] = json!(target);
+        }
+        self.views.push(view);
+        accessor["bufferView"] = json!(self.views.len() - 1);
+        self.accessors.push(accessor);
         self.accessors.len() - 1
     }
 

@@ -120,13 +120,32 @@ fn check_layout(json: &Value, buffer_len: usize) {
             "VEC4" => 4,
             other => panic!("{other}"),
         };
-        assert_eq!(a["componentType"], 5126, "FLOAT");
+        // FLOAT for everything but vertex indices, UNSIGNED_INT; 4 bytes either way.
+        assert!(
+            a["componentType"] == 5126 || a["componentType"] == 5125,
+            "{a}"
+        );
         let count = a["count"].as_u64().unwrap();
         let view = &json["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
         assert!(count >= 1);
         assert_eq!(count * n * 4, view["byteLength"].as_u64().unwrap(), "{a}");
         assert_eq!(a["min"].as_array().unwrap().len() as u64, n, "{a}");
         assert_eq!(a["max"].as_array().unwrap().len() as u64, n, "{a}");
+    }
+    for mesh in json["meshes"].as_array().unwrap() {
+        let primitive = &mesh["primitives"][0];
+        let indices = &accessors[primitive["indices"].as_u64().unwrap() as usize];
+        assert_eq!(
+            (&indices["componentType"], &indices["type"]),
+            (&5125.into(), &"SCALAR".into())
+        );
+        let view = &json["bufferViews"][indices["bufferView"].as_u64().unwrap() as usize];
+        assert_eq!(view["target"], 34963, "ELEMENT_ARRAY_BUFFER");
+        let positions = &accessors[primitive["attributes"]["POSITION"].as_u64().unwrap() as usize];
+        assert_eq!(
+            indices["max"][0].as_u64().unwrap() + 1,
+            positions["count"].as_u64().unwrap()
+        );
     }
     for animation in json["animations"].as_array().unwrap() {
         for s in animation["samplers"].as_array().unwrap() {
@@ -244,7 +263,40 @@ fn bounds(doc: &gltf::Gltf, bin: &[u8], name: &str) -> ([f32; 3], [f32; 3]) {
     let max: [f32; 3] = f32s(&accessor.max().unwrap()).try_into().unwrap();
     let reader = primitive.reader(|_| Some(bin));
     let points: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
-    assert_eq!(points.len() % 3, 0, "{name}: whole triangles");
+    let indices: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
+    assert_eq!(indices.len() % 3, 0, "{name}: whole triangles");
+    assert!(
+        indices.iter().all(|i| (*i as usize) < points.len()),
+        "{name}"
+    );
+    let mut distinct = points
+        .iter()
+        .map(|p| p.map(f32::to_bits))
+        .collect::<Vec<_>>();
+    distinct.sort();
+    distinct.dedup();
+    assert_eq!(
+        distinct.len(),
+        points.len(),
+        "{name}: a vertex written twice"
+    );
+    if !STATIC.contains(&name) {
+        // A closed surface, its faces turned one way: every edge a→b of a triangle is
+        // met once, and b→a once, by its neighbour.
+        let mut edges = BTreeMap::new();
+        for t in indices.chunks_exact(3) {
+            for k in 0..3 {
+                *edges.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;
+            }
+        }
+        for ((a, b), n) in &edges {
+            assert_eq!(
+                (*n, edges.get(&(*b, *a))),
+                (1, Some(&1)),
+                "{name}: edge {a}-{b}"
+            );
+        }
+    }
     for i in 0..3 {
         // The spec's rule: min and max are the exact extremes of the data.
         assert_eq!(
