@@ -9,8 +9,9 @@
 //! qx,qy,qz,qw rounded to f32, glTF's only float: a file and a CSV of one run agree to the
 //! last bit of an f32.
 //!
-//! glTF is y-up and in metres, as Tumble's scenes are by default; a scene with another
-//! gravity is written as it is (nothing is turned).
+//! glTF is y-up and in metres, as Tumble's scenes are by default. A z-up scene (a model
+//! from URDF or MJCF, gravity along −z) keeps its bodies' nodes and keyframes as they are,
+//! under one more node that turns +z to +y (`--up`).
 
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -83,6 +84,12 @@ pub struct GltfArgs {
     #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = crate::args::threads)]
     pub threads: Option<usize>,
 
+    /// The scene's up axis: y (written as it is) or z (the bodies' nodes placed under one
+    /// node "z-up" that turns +z to glTF's +y, so models from URDF or MJCF files stand
+    /// up in viewers); auto, the default: z when gravity points mostly along −z.
+    #[arg(long, value_name = "AXIS", default_value = "auto", value_parser = ["auto", "y", "z"])]
+    pub up: String,
+
     /// Print nothing on standard output and show no progress bar.
     #[arg(long, short)]
     pub quiet: bool,
@@ -140,7 +147,15 @@ pub fn export(args: &GltfArgs) -> Result<(), Failure> {
     let mut progress = Progress::new(plan.steps, "recording", args.quiet);
     let stopped = record(&mut scene, &plan, args.every, &mut recording, &mut progress);
     progress.finish();
-    let (doc, buffer) = document(&scene, &recording);
+    let z_up = match args.up.as_str() {
+        "z" => true,
+        "y" => false,
+        _ => {
+            let g = scene.world.gravity();
+            g.z < 0.0 && g.z.abs() > g.x.abs().max(g.y.abs())
+        }
+    };
+    let (doc, buffer) = document(&scene, &recording, z_up);
     let bytes = match format {
         Format::Glb => glb::glb(doc, buffer).map_err(|e| Failure::Input(format!("out: {e}")))?,
         Format::Gltf => glb::gltf(doc, buffer),
@@ -310,7 +325,7 @@ fn record(
 }
 
 /// The glTF document of a recorded run, and its binary data.
-fn document(scene: &Scene, recording: &Recording) -> (Value, Buffer) {
+fn document(scene: &Scene, recording: &Recording, z_up: bool) -> (Value, Buffer) {
     let colours: Vec<Option<Rgb>> = scene.body_colors.iter().map(|c| c.map(Rgb)).collect();
     let model = Model::new(&scene.world, &colours, f32::INFINITY);
     let half_side = PLANE_MIN_HALF_SIDE.max(PLANE_REACH * recording.reach);
@@ -359,11 +374,7 @@ fn document(scene: &Scene, recording: &Recording) -> (Value, Buffer) {
             "generator": concat!("tumble export-gltf ", env!("CARGO_PKG_VERSION")),
         },
     });
-    if !nodes.is_empty() {
-        doc["scene"] = json!(0);
-        doc["scenes"] = json!([{"name": title, "nodes": (0..nodes.len()).collect::<Vec<_>>()}]);
-        doc["nodes"] = Value::Array(nodes);
-    }
+    place(&mut doc, nodes, &title, z_up);
     if !meshes.is_empty() {
         doc["meshes"] = Value::Array(meshes);
         doc["materials"] = Value::Array(materials);
@@ -372,6 +383,26 @@ fn document(scene: &Scene, recording: &Recording) -> (Value, Buffer) {
         doc["animations"] = json!([animation]);
     }
     (doc, buffer)
+}
+
+/// The scene of `doc`: the bodies' `nodes`, or, when the scene is `z_up`, one node above
+/// them turning it −90° about x, which takes its +z to glTF's +y (and +y to −z). Nothing
+/// when there are no bodies (glTF wants no empty list).
+fn place(doc: &mut Value, mut nodes: Vec<Value>, title: &str, z_up: bool) {
+    if nodes.is_empty() {
+        return;
+    }
+    let bodies: Vec<usize> = (0..nodes.len()).collect();
+    let roots = if z_up {
+        let h = std::f32::consts::FRAC_1_SQRT_2;
+        nodes.push(json!({"name": "z-up", "rotation": [-h, 0.0, 0.0, h], "children": bodies}));
+        vec![nodes.len() - 1]
+    } else {
+        bodies
+    };
+    doc["scene"] = json!(0);
+    doc["scenes"] = json!([{"name": title, "nodes": roots}]);
+    doc["nodes"] = Value::Array(nodes);
 }
 
 /// One animation with a translation and a rotation channel per body that is not static,

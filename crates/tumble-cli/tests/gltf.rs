@@ -567,6 +567,7 @@ fn bad_input_is_one_line_and_writes_nothing() {
         (vec!["spring", "--out", o, "--steps", "3", "--duration", "1"], "steps: cannot be given together with --duration".into()),
         (vec!["spring", "--out", o, "--threads", "0"], "threads: must be a whole number from 1 to".into()),
         (vec!["spring"], "out: required; see 'tumble export-gltf --help'".into()),
+        (vec!["spring", "--out", o, "--up", "x"], "up: 'x' is not a valid value".into()),
         // Step 2^17 / 0.01 s on, 0.01 s is less than an f32 ulp (1/64 s).
         (vec!["spring", "--out", o, "--steps", "20000000"], "every: steps 13107201 and 13107202 are both at 131072.02 s in f32, glTF's float for animation times; keyframe fewer steps with a larger --every".into()),
         // 10^8 + 2 keyframes of 4 + 28 bytes.
@@ -577,5 +578,66 @@ fn bad_input_is_one_line_and_writes_nothing() {
         assert!(line.starts_with(&expected), "{args:?}: {line}");
     }
     assert_eq!(names(&dir), ["scene.glb"], "nothing written");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// A model's world: z up, gravity along −z.
+const Z_UP: &str = r#"{
+  "gravity": [0, 0, -9.81], "duration": 0.1,
+  "bodies": [
+    {"name": "floor", "kind": "static", "shape": {"type": "plane", "normal": [0, 0, 1]}},
+    {"name": "link", "shape": {"type": "box", "half_extents": [0.1, 0.1, 0.5]}, "position": [1, 0, 2]}
+  ]
+}"#;
+
+/// With gravity along −z the bodies hang under one node that turns +z to glTF's +y (auto,
+/// or `--up z`); `--up y` writes them as they are. The bodies' own nodes and keyframes do
+/// not change.
+#[test]
+fn a_z_up_scene_stands_up_under_one_node() {
+    let dir = scratch("gltf-z-up");
+    let scene = dir.join("model.json");
+    std::fs::write(&scene, Z_UP).unwrap();
+    let export = |up: &str, out: &str| {
+        let out = dir.join(out);
+        ok(&[
+            "export-gltf",
+            path(&scene),
+            "--out",
+            path(&out),
+            "--up",
+            up,
+            "-q",
+        ]);
+        let bytes = std::fs::read(&out).unwrap();
+        gltf::Gltf::from_slice(&bytes).expect("valid glTF 2.0");
+        chunks(&bytes)
+    };
+    let (auto, bin) = export("auto", "auto.glb");
+    let h = std::f32::consts::FRAC_1_SQRT_2;
+    assert_eq!(auto["nodes"][2]["name"], "z-up");
+    assert_eq!(f32s(&auto["nodes"][2]["rotation"]), [-h, 0.0, 0.0, h]);
+    assert_eq!(auto["nodes"][2]["children"], serde_json::json!([0, 1]));
+    assert_eq!(auto["scenes"][0]["nodes"], serde_json::json!([2]));
+    assert_eq!(export("z", "z.glb"), (auto.clone(), bin.clone()));
+    let (y, y_bin) = export("y", "y.glb");
+    assert_eq!(y["nodes"].as_array().unwrap().len(), 2);
+    assert_eq!(y["scenes"][0]["nodes"], serde_json::json!([0, 1]));
+    assert_eq!(
+        (&y["nodes"][1], &y["animations"]),
+        (&auto["nodes"][1], &auto["animations"])
+    );
+    assert_eq!(y_bin, bin);
+    // The link starts 2 m above the floor: in glTF's frame, 2 m up +y (the root's
+    // rotation of (1, 0, 2) is (1, 2, 0), to f32 rounding of cos 90° ≈ 1e-8).
+    let doc = gltf::Gltf::from_slice(&std::fs::read(dir.join("auto.glb")).unwrap()).unwrap();
+    let root = doc.nodes().nth(2).unwrap().transform().matrix();
+    let p = [1.0f32, 0.0, 2.0];
+    let world: Vec<f32> = (0..3)
+        .map(|r| (0..3).map(|c| root[c][r] * p[c]).sum::<f32>() + root[3][r])
+        .collect();
+    for (got, want) in world.iter().zip([1.0, 2.0, 0.0]) {
+        assert!((got - want).abs() < 1e-6, "{world:?}");
+    }
     std::fs::remove_dir_all(dir).unwrap();
 }
