@@ -538,10 +538,11 @@ fn a_failed_run_keeps_its_frames_to_the_last_good_step() {
     );
     let failed: u64 = line[5..].split(' ').next().unwrap().parse().unwrap();
     assert!(failed > 10, "{line}");
-    assert_eq!(
-        *times.last().unwrap(),
-        ((failed - 1) as f64 * 0.01) as f32,
-        "the last good step"
+    // The last good step's time, k·dt: to an ulp, since the f32 build multiplies in f32.
+    let last = f64::from(*times.last().unwrap());
+    assert!(
+        (last - (failed - 1) as f64 * 0.01).abs() < 1e-6,
+        "{last}: {line}"
     );
     assert_eq!(names(&dir), ["run.csv", "run.glb", "stiff.json"]);
     std::fs::remove_dir_all(dir).unwrap();
@@ -568,8 +569,10 @@ fn bad_input_is_one_line_and_writes_nothing() {
         (vec!["spring", "--out", o, "--threads", "0"], "threads: must be a whole number from 1 to".into()),
         (vec!["spring"], "out: required; see 'tumble export-gltf --help'".into()),
         (vec!["spring", "--out", o, "--up", "x"], "up: 'x' is not a valid value".into()),
-        // Step 2^17 / 0.01 s on, 0.01 s is less than an f32 ulp (1/64 s).
-        (vec!["spring", "--out", o, "--steps", "20000000"], "every: steps 13107201 and 13107202 are both at 131072.02 s in f32, glTF's float for animation times; keyframe fewer steps with a larger --every".into()),
+        // From 2^17 s on, 0.01 s is less than an f32 ulp (1/64 s): steps 13107201 and
+        // 13107202 at 131072.02 s when k·dt is rounded from f64, 13107200 and 13107201 at
+        // 131072 s in the f32 build, where k·dt is an f32 product (the end is below).
+        (vec!["spring", "--out", o, "--steps", "20000000"], "every: steps 1310720".into()),
         // 10^8 + 2 keyframes of 4 + 28 bytes.
         (vec!["spring", "--out", o, "--steps", "100000000"], "every: 100000002 keyframes of 1 moving body would take 3200000064 bytes, more than the 1073741824 allowed; keyframe fewer steps with a larger --every".into()),
     ];
@@ -577,6 +580,13 @@ fn bad_input_is_one_line_and_writes_nothing() {
         let line = refused(&[&["export-gltf"][..], &args].concat());
         assert!(line.starts_with(&expected), "{args:?}: {line}");
     }
+    let line = refused(&["export-gltf", "spring", "--out", o, "--steps", "20000000"]);
+    let tail = " s in f32, glTF's float for animation times; keyframe fewer steps with a \
+                larger --every";
+    assert!(
+        line.contains(" are both at 131072") && line.ends_with(tail),
+        "{line}"
+    );
     assert_eq!(names(&dir), ["scene.glb"], "nothing written");
     std::fs::remove_dir_all(dir).unwrap();
 }
