@@ -316,12 +316,13 @@ fn bounds(doc: &gltf::Gltf, bin: &[u8], name: &str) -> ([f32; 3], [f32; 3]) {
     (min, max)
 }
 
-/// The meshes span the shapes' sizes: exactly (the same f64 → f32 rounding) for shapes
+/// The meshes span the shapes' sizes, every vertex once and closed shapes watertight
+/// (see `bounds`): exactly (the same f64 → f32 rounding) for shapes
 /// given by their corners; to 1e-6 m for the round ones, whose rim points come from f32
 /// sines and cosines (errors of a few ulp of 0.3 m, ~1e-7 m). The quad of a plane lies in
 /// it and spans at least 5 m either side.
 #[test]
-fn meshes_span_the_shapes_and_materials_carry_their_colours() {
+fn meshes_span_the_shapes() {
     let dir = scratch("gltf-meshes");
     let scene = write_scene(&dir);
     let glb = dir.join("run.glb");
@@ -369,8 +370,27 @@ fn meshes_span_the_shapes_and_materials_carry_their_colours() {
     let (min, max) = bounds(&doc, &bin, "ground");
     assert_eq!((min[1], max[1]), (0.0, 0.0), "the quad lies in y = 0");
     assert!(min[0] <= -5.0 && min[2] <= -5.0 && max[0] >= 5.0 && max[2] >= 5.0);
+    std::fs::remove_dir_all(dir).unwrap();
+}
 
-    // sRGB bytes decoded to glTF's linear base colour (IEC 61966-2-1).
+/// Each body's material is its colour as `tumble render` paints it (the scene's `color`,
+/// else the palette's, kept in `extras.color`), sRGB decoded to glTF's linear base colour
+/// (IEC 61966-2-1); only open surfaces (planes, meshes, height fields) are two-sided.
+#[test]
+fn materials_carry_the_render_colours() {
+    let dir = scratch("gltf-colours");
+    let scene = write_scene(&dir);
+    let glb = dir.join("run.glb");
+    ok(&[
+        "export-gltf",
+        &scene,
+        "--out",
+        path(&glb),
+        "--steps",
+        "1",
+        "-q",
+    ]);
+    let doc = gltf::Gltf::from_slice(&std::fs::read(&glb).unwrap()).unwrap();
     let linear = |byte: u8| {
         let c = f64::from(byte) / 255.0;
         if c <= 0.04045 {
@@ -384,15 +404,19 @@ fn meshes_span_the_shapes_and_materials_carry_their_colours() {
         let material = node.mesh().unwrap().primitives().next().unwrap().material();
         assert_eq!(material.name(), Some(name));
         let factor = material.pbr_metallic_roughness().base_color_factor();
+        let kind = if STATIC.contains(&name) {
+            tumble::BodyKind::Static
+        } else {
+            tumble::BodyKind::Dynamic // the kinematic lift is coloured as a moving body
+        };
         let hex = match name {
             "ball" => "#ff0000".to_string(),
             "ramp" => "#808080".to_string(),
-            _ => {
-                let extras: Value =
-                    serde_json::from_str(material.extras().as_ref().unwrap().get()).unwrap();
-                extras["color"].as_str().unwrap().to_string()
-            }
+            _ => tumble_render::palette(node.index(), kind).hex(),
         };
+        let extras: Value =
+            serde_json::from_str(material.extras().as_ref().unwrap().get()).unwrap();
+        assert_eq!(extras["color"], hex.as_str(), "{name}");
         let bytes: Vec<u8> = (0..3)
             .map(|i| u8::from_str_radix(&hex[1 + 2 * i..3 + 2 * i], 16).unwrap())
             .collect();
