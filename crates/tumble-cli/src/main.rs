@@ -10,6 +10,8 @@
 mod analyze;
 mod args;
 mod contacts;
+mod export_gltf;
+mod glb;
 mod output;
 mod plot;
 mod progress;
@@ -85,6 +87,11 @@ enum Command {
     ExportHtml(web::ExportArgs),
     /// Serve the page of `export-html` on localhost and open it in the browser.
     View(web::ViewArgs),
+    /// Write a run as glTF 2.0 (.glb, or .gltf with its buffer embedded) for Blender,
+    /// three.js and model viewers: a node per body named as the body, its shape as a mesh
+    /// in its colour, and its translation and rotation keyframed at every recorded step
+    /// (the steps `tumble run --out` records with the same options), time in seconds.
+    ExportGltf(export_gltf::GltfArgs),
 }
 
 /// Why the program stops early.
@@ -132,6 +139,7 @@ fn main() -> ExitCode {
         Command::Plot(args) => plot::plot(&args),
         Command::ExportHtml(args) => web::export(&args),
         Command::View(args) => web::view(&args),
+        Command::ExportGltf(args) => export_gltf::export(&args),
         Command::Scenes => report::list_scenes(),
         Command::Contacts(args) => contacts::contacts(&args),
         Command::Render(args) => render::render(&args),

@@ -122,7 +122,9 @@ fn arc(r: f32, y0: f32, from: f32, to: f32) -> Vec<(f32, f32)> {
     (0..=n)
         .map(|i| {
             let t = a + (b - a) * i as f32 / n as f32;
-            (r * t.cos(), y0 + r * t.sin())
+            // cos(±π/2) is −4e-8 in f32, not 0: a pole's radius is clamped to 0, so
+            // that every slice meets at one point and the surface closes.
+            ((r * t.cos()).max(0.0), y0 + r * t.sin())
         })
         .collect()
 }
@@ -130,7 +132,8 @@ fn arc(r: f32, y0: f32, from: f32, to: f32) -> Vec<(f32, f32)> {
 /// The surface swept by a profile of (radius, y) points turned about the y axis.
 fn lathe(profile: &[(f32, f32)], out: &mut Vec<Tri>) {
     let ring = |(r, y): (f32, f32), k: usize| {
-        let phi = std::f32::consts::TAU * k as f32 / SLICES as f32;
+        // Slice SLICES is slice 0 again (sin τ is not 0 in f32): the seam closes.
+        let phi = std::f32::consts::TAU * (k % SLICES) as f32 / SLICES as f32;
         Vec3::new(r * phi.cos(), y, -r * phi.sin())
     };
     for w in profile.windows(2) {
