@@ -32,6 +32,7 @@ mod joint_edit;
 mod joints;
 mod properties;
 pub mod query;
+mod snapshot;
 pub(crate) mod step;
 
 use crate::collision::broad_phase::{BroadPhase, ProxyId};
@@ -546,3 +547,32 @@ impl World {
         diagnostics::state_hash(&self.bodies.list)
     }
 }
+
+crate::codec::codec_struct!(Tolerances {
+    contact_margin,
+    aabb_margin,
+    scales,
+    sleep_speed
+});
+crate::codec::codec_struct!(Settings {
+    gravity,
+    integrator,
+    tolerances,
+    solver,
+    sleep,
+    limits,
+    contacts
+});
+crate::codec::codec_struct!(Clock { time, steps });
+crate::codec::codec_struct!(BodyStore { list, handles });
+crate::codec::codec_struct!(JointStore {
+    list,
+    handles,
+    links,
+    joined_pairs
+});
+crate::codec::codec_struct!(CollisionStore {
+    broad_phase,
+    proxies,
+    contacts
+});
