@@ -247,7 +247,7 @@ fn settled() -> (World, Vec<u8>) {
 /// checking that the world did not change.
 fn refused(bytes: &[u8]) -> String {
     let (mut target, good) = settled();
-    let err = target.restore(bytes).err().expect("refused");
+    let err = target.restore(bytes).expect_err("refused");
     assert_eq!(target.snapshot(), good, "a refused restore changes nothing");
     assert!(matches!(err, Error::Snapshot { .. }));
     err.to_string()

@@ -304,6 +304,10 @@ impl Body {
     pub fn pose(&self) -> crate::collision::geometry::Pose {
         crate::collision::geometry::Pose::new(self.position(), self.orientation)
     }
+    /// Whether the body is a bullet (swept against moving bodies too).
+    pub fn is_bullet(&self) -> bool {
+        self.bullet
+    }
     /// False while the body's island sleeps.
     pub fn is_awake(&self) -> bool {
         self.awake

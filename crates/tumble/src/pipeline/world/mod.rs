@@ -146,6 +146,8 @@ impl Tolerances {
 pub(crate) struct Settings {
     pub gravity: Vec3,
     pub integrator: Integrator,
+    /// The scene's length scale (m), which `tolerances` were derived from.
+    pub length_unit: Real,
     pub tolerances: Tolerances,
     pub solver: SolverSettings,
     pub sleep: bool,
@@ -274,6 +276,7 @@ impl World {
             settings: Settings {
                 gravity: def.gravity,
                 integrator: def.integrator,
+                length_unit: unit,
                 tolerances,
                 solver: def.solver,
                 sleep: def.sleep,
@@ -430,6 +433,12 @@ impl World {
         self.clock.steps
     }
 
+    /// The length scale the world's tolerances were derived from (m; see
+    /// [`WorldDef::length_unit`]).
+    pub fn length_unit(&self) -> Real {
+        self.settings.length_unit
+    }
+
     /// Speculative contact distance (m).
     pub fn contact_margin(&self) -> Real {
         self.settings.tolerances.contact_margin
@@ -557,6 +566,7 @@ crate::codec::codec_struct!(Tolerances {
 crate::codec::codec_struct!(Settings {
     gravity,
     integrator,
+    length_unit,
     tolerances,
     solver,
     sleep,
