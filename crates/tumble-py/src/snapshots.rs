@@ -72,6 +72,26 @@ impl PyWorld {
         self.__copy__()
     }
 
+    /// Writes the world as a scene file (docs/scene-format.md) at `path`: every body,
+    /// force and joint as scene keys, `simulate`'s default `dt` and `duration`, and with
+    /// `state=True` (the default) the world's snapshot as the `"state"` section, so that
+    /// `World.from_scene(path)` continues it bit-identically. Without it the file is a
+    /// fresh scene at the current poses and velocities.
+    #[pyo3(signature = (path, *, state = true))]
+    fn save_scene(&self, path: std::path::PathBuf, state: bool) -> PyResult<()> {
+        let text = {
+            let g = self.lock()?;
+            let options = tumble_scene::SaveOptions {
+                dt: g.dt,
+                duration: g.duration,
+                state,
+                ..Default::default()
+            };
+            tumble_scene::save_with(&g.world, &options)
+        };
+        std::fs::write(&path, text).map_err(PyErr::from)
+    }
+
     /// A copy is a deep one: the world's state through a snapshot.
     fn __copy__(&self) -> PyResult<PyWorld> {
         let g = self.lock()?;

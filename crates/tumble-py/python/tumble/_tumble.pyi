@@ -757,6 +757,9 @@ class World:
     @staticmethod
     def from_snapshot(data: bytes) -> World:
         """A new world continuing a snapshot (one taken without force callbacks)."""
+    def save_scene(self, path: Union[str, PathLike[str]], *, state: bool = True) -> None:
+        """Writes the world as a scene file; with state, World.from_scene continues it
+        bit-identically."""
     @staticmethod
     def _from_pickle(data: bytes, dt: float, duration: float) -> World: ...
     def __reduce__(self) -> tuple[object, tuple[bytes, float, float]]: ...
