@@ -13,7 +13,7 @@ use crate::{stdout_failure, Failure};
 /// Seconds between the seed table's rows.
 const TABLE_INTERVAL: Real = 0.1;
 
-fn say(args: std::fmt::Arguments<'_>) -> Result<(), Failure> {
+pub fn say(args: std::fmt::Arguments<'_>) -> Result<(), Failure> {
     writeln!(io::stdout(), "{args}").map_err(stdout_failure)
 }
 

@@ -7,7 +7,7 @@ use tumble::{Real, World};
 use tumble_scene::{RunPlan, Scene, SceneError, MAX_PASSES, MAX_STEPS};
 
 use crate::args::{number, whole, whole_u32};
-use crate::output::{check_distinct, inputs, scene_file, Target};
+use crate::output::{check_distinct, inputs, scene_file, Target, Writer};
 use crate::record::{
     CsvFile, CONTACT_IMPULSES_HEADER, DIAGNOSTICS_HEADER, JOINT_REACTIONS_HEADER,
     SENSOR_EVENTS_HEADER, TRAJECTORY_HEADER,
@@ -120,6 +120,13 @@ pub struct RunArgs {
     /// standard error).
     #[arg(long, short)]
     pub quiet: bool,
+
+    /// Write the world at the end of the run to FILE.json: a scene file with the world's
+    /// whole state (its "state" section), so that `tumble run FILE.json` continues it
+    /// bit-identically. The continued run's clock goes on from the saved time, and
+    /// --duration (default: this run's length) is how much longer to run.
+    #[arg(long, value_name = "FILE.json")]
+    pub save_state: Option<PathBuf>,
 }
 
 impl Default for RunArgs {
@@ -141,6 +148,7 @@ impl Default for RunArgs {
             threads: None,
             every: 1,
             quiet: false,
+            save_state: None,
         }
     }
 }
@@ -165,10 +173,18 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
             .set_threads(n)
             .map_err(|e| Failure::Input(e.to_string()))?;
     }
+    if args.save_state.is_some() && scene.character.is_some() {
+        return Err(Failure::Input(
+            "save-state: a scene with a character cannot be saved yet (its path and fall \
+             are not world state)"
+                .into(),
+        ));
+    }
     let plan = plan(args, &scene)?;
+    let times = Times::new(plan, scene.world.step_count());
     let mut sinks = Sinks::open(args, &scene, &plan)?;
     let mut progress = crate::progress::Progress::new(plan.steps, "running", args.quiet);
-    let stopped = step_all(&mut scene, &plan, args.every, &mut sinks, &mut progress)?;
+    let stopped = step_all(&mut scene, &times, args.every, &mut sinks, &mut progress)?;
     progress.finish();
     sinks.finish(&scene, &plan, stopped.is_none())?;
     stopped.map_or(Ok(()), Err)
@@ -196,6 +212,41 @@ fn plan(args: &RunArgs, scene: &Scene) -> Result<RunPlan, SceneError> {
     }
 }
 
+/// The times a run reports: k·dt after step k, counted from the start of the world's
+/// run, so that a world saved after `first` steps of dt (`--save-state`) and run on
+/// reports the times the run that never stopped does.
+struct Times {
+    plan: RunPlan,
+    first: u64,
+    /// The plan of the whole run, from the world's first step.
+    whole: RunPlan,
+}
+
+impl Times {
+    fn new(plan: RunPlan, first: u64) -> Times {
+        let steps = first.saturating_add(plan.steps);
+        let whole = if plan.last_dt == plan.dt {
+            RunPlan::from_steps(steps, plan.dt).unwrap_or(plan)
+        } else {
+            RunPlan {
+                steps,
+                end_time: first as Real * plan.dt + plan.end_time,
+                ..plan
+            }
+        };
+        Times { plan, first, whole }
+    }
+
+    /// The time after step `k` of this run.
+    fn after(&self, k: u64) -> Real {
+        if self.first == 0 {
+            self.plan.time_after(k)
+        } else {
+            self.whole.time_after(self.first + k)
+        }
+    }
+}
+
 /// `--substeps`, `--iterations`: the scene format's rule for its keys of the same names.
 fn passes(text: &str) -> Result<u32, String> {
     whole_u32(text, 1, MAX_PASSES)
@@ -207,25 +258,50 @@ fn passes(text: &str) -> Result<u32, String> {
 /// if it was not already, and the step's failure returned.
 fn step_all(
     scene: &mut Scene,
-    plan: &RunPlan,
+    times: &Times,
     every: u64,
     sinks: &mut Sinks,
     progress: &mut crate::progress::Progress,
 ) -> Result<Option<Failure>, Failure> {
-    sinks.observe(0, 0.0, &scene.world, true)?;
+    let plan = &times.plan;
+    sinks.observe(0, times.after(0), &scene.world, true)?;
     for k in 1..=plan.steps {
         if let Err(e) = scene.step(plan.step_dt(k)) {
             let good = k - 1;
             if good % every != 0 {
-                sinks.record(plan.time_after(good), &scene.world)?;
+                sinks.record(times.after(good), &scene.world)?;
             }
             return Ok(Some(crate::sample::step_failure(k, e)));
         }
         let record = k % every == 0 || k == plan.steps;
-        sinks.observe(k, plan.time_after(k), &scene.world, record)?;
+        sinks.observe(k, times.after(k), &scene.world, record)?;
         progress.inc(1);
     }
     Ok(None)
+}
+
+/// `--save-state`: the world as a scene file with its state, the run's dt, and its length
+/// as the default length of the run that continues it. Written whether or not the run
+/// completed: a failed step was undone, so the world is the last good step's.
+fn save_state(target: Target, scene: &Scene, plan: &RunPlan, quiet: bool) -> Result<(), Failure> {
+    let options = tumble_scene::SaveOptions {
+        name: scene.name.clone(),
+        description: scene.description.clone(),
+        dt: plan.dt,
+        duration: plan.end_time,
+        colors: scene.body_colors.clone(),
+        state: true,
+    };
+    let text = tumble_scene::save_with(&scene.world, &options);
+    let shown = target.shown().to_string();
+    let mut out = Writer::create(target)?;
+    out.write(format_args!("{text}"))?;
+    out.finish()?;
+    if !quiet {
+        let time = crate::record::Num(scene.world.time());
+        crate::report::say(format_args!("wrote '{shown}' (the world at t = {time} s)"))?;
+    }
+    Ok(())
 }
 
 /// Everything that watches the run: the CSV files and the printed reports.
@@ -235,6 +311,8 @@ struct Sinks {
     contacts: Option<CsvFile>,
     joints: Option<CsvFile>,
     sensors: Option<CsvFile>,
+    /// `--save-state`: where the world goes at the end.
+    state: Option<Target>,
     seed_table: Option<SeedTable>,
     summary: Option<Summary>,
     labels: Vec<String>,
@@ -254,13 +332,14 @@ impl Sinks {
             check("contacts", &args.contacts)?,
             check("joints", &args.joints)?,
             check("sensors", &args.sensors)?,
+            check("save-state", &args.save_state)?,
         ];
         let scene_file = args.scene.as_deref().and_then(scene_file);
         check_distinct(
             &targets.iter().flatten().collect::<Vec<_>>(),
             &inputs(&scene_file),
         )?;
-        let [out, diagnostics, contacts, joints, sensors] = targets;
+        let [out, diagnostics, contacts, joints, sensors, state] = targets;
         let csv =
             |target: Option<Target>, header| target.map(|t| CsvFile::create(t, header)).transpose();
         let seed = args.scene.is_none() && !args.quiet;
@@ -270,6 +349,7 @@ impl Sinks {
             contacts: csv(contacts, CONTACT_IMPULSES_HEADER)?,
             joints: csv(joints, JOINT_REACTIONS_HEADER)?,
             sensors: csv(sensors, SENSOR_EVENTS_HEADER)?,
+            state,
             seed_table: seed
                 .then(|| SeedTable::new(&scene.world, plan))
                 .transpose()?,
@@ -328,6 +408,9 @@ impl Sinks {
         {
             let path = csv.shown().to_string();
             written.push((path, csv.finish()?));
+        }
+        if let Some(target) = self.state {
+            save_state(target, scene, plan, self.quiet)?;
         }
         if completed {
             if let Some(table) = self.seed_table {

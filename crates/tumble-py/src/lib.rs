@@ -18,6 +18,7 @@ mod joints;
 mod query;
 mod shapes;
 mod sim;
+mod snapshots;
 mod steps;
 mod world;
 

@@ -1,6 +1,6 @@
 //! Bodies: one entry of the `bodies` array, read into a `BodyDef` and a `Shape`.
 
-use tumble::{BodyDef, BodyKind, InertiaSpec, MassSpec, Mat3, Quat, Shape, Vec3};
+use tumble::{BodyDef, BodyId, BodyKind, InertiaSpec, MassSpec, Mat3, Quat, Shape, Vec3, World};
 
 use crate::error::{printable, Result};
 use crate::reader::{Node, Obj};
@@ -169,4 +169,21 @@ fn inertia(node: &Node<'_>) -> Result<InertiaSpec> {
     Ok(InertiaSpec::Tensor(
         Mat3::from_cols_array_2d(&[a?, b?, c?]).transpose(),
     ))
+}
+
+/// The body a force or joint refers to: by name, or by its index in `bodies` (how a saved
+/// scene names a body that has no name).
+pub(crate) fn reference(node: &Node<'_>, world: &World) -> Result<BodyId> {
+    if node.is_number() {
+        let i = node.whole(u64::MAX)?;
+        let ids = world.body_ids();
+        return usize::try_from(i)
+            .ok()
+            .and_then(|i| ids.get(i).copied())
+            .ok_or_else(|| node.err(format!("no body at index {i} (there are {})", ids.len())));
+    }
+    let name = node.str()?;
+    world
+        .find_body(name)
+        .ok_or_else(|| node.err(format!("no body named '{}'", printable(name))))
 }

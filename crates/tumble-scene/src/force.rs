@@ -105,9 +105,5 @@ fn other_body(obj: &Obj<'_>, a: BodyId, world: &World) -> Result<BodyId> {
 }
 
 fn body(obj: &Obj<'_>, key: &str, world: &World) -> Result<BodyId> {
-    let node = obj.required(key)?;
-    let name = node.str()?;
-    world
-        .find_body(name)
-        .ok_or_else(|| node.err(format!("no body named '{}'", printable(name))))
+    crate::body::reference(&obj.required(key)?, world)
 }

@@ -170,10 +170,7 @@ fn servo(obj: &Obj<'_>, key: &str, limit_key: &str) -> Result<Option<Servo>> {
     }))
 }
 
-/// The body a name refers to.
+/// The body a name (or an index into `bodies`) refers to.
 fn named_body(node: Node<'_>, world: &World) -> Result<BodyId> {
-    let name = node.str()?;
-    world
-        .find_body(name)
-        .ok_or_else(|| node.err(format!("no body named '{}'", printable(name))))
+    crate::body::reference(&node, world)
 }

@@ -20,6 +20,7 @@ mod force;
 mod joint;
 mod plan;
 mod reader;
+mod save;
 mod shape;
 
 use std::fmt;
@@ -37,14 +38,16 @@ pub use force::FORCE_TYPES;
 pub use joint::JOINT_TYPES;
 pub use plan::{RunPlan, MAX_STEPS};
 pub use reader::{whole_rule, ROOT};
+pub use save::{save, save_scene, save_with, SaveOptions};
 pub use shape::SHAPE_TYPES;
 // Python checks the names it is given with the same rule.
 pub use body::check_name;
 
 use reader::{Node, Obj};
 
-const TOP_KEYS: [&str; 24] = [
+const TOP_KEYS: [&str; 25] = [
     "name",
+    "state",
     "description",
     "gravity",
     "dt",
@@ -220,6 +223,9 @@ fn build(root: &Node<'_>) -> Result<Scene> {
         }
         None => None,
     };
+    if let Some(node) = obj.get("state") {
+        restore_state(&node, &mut world, body_names.len())?;
+    }
     Ok(Scene {
         name,
         description,
@@ -230,6 +236,18 @@ fn build(root: &Node<'_>) -> Result<Scene> {
         body_colors,
         character,
     })
+}
+
+/// The `state` section (a snapshot in hex, see `save.rs`) restored into the world built
+/// from the keys; it must hold as many bodies as the scene lists.
+fn restore_state(node: &Node<'_>, world: &mut World, bodies: usize) -> Result<()> {
+    let bytes = save::unhex(node.str()?).map_err(|reason| node.err(reason))?;
+    world.restore(&bytes).map_err(|e| node.err(e.to_string()))?;
+    let held = world.body_count();
+    if held != bodies {
+        return Err(node.err(format!("holds {held} bodies, but the scene lists {bodies}")));
+    }
+    Ok(())
 }
 
 /// `max_speed` and `max_angular_speed`, each defaulting to the engine's value for the

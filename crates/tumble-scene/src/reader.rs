@@ -44,6 +44,11 @@ impl<'a> Node<'a> {
         }
     }
 
+    /// Whether the value is a JSON number.
+    pub fn is_number(&self) -> bool {
+        self.value.is_number()
+    }
+
     /// Whether the value is JSON null.
     pub fn is_null(&self) -> bool {
         self.value.is_null()

@@ -50,6 +50,13 @@ pub enum Error {
         .0.reason
     )]
     CallbackFailed(Box<CallbackFailed>),
+    /// A snapshot could not be read (truncated, corrupted, another format version or
+    /// precision, or force callbacks that do not match); the target world is unchanged.
+    #[error("snapshot: {what}")]
+    Snapshot {
+        /// What is wrong, with the byte offset where it was found.
+        what: String,
+    },
 }
 
 /// Which step a force callback stopped, and the callback's reason.
@@ -110,6 +117,11 @@ fn unstable_message(u: &Unstable) -> String {
 }
 
 impl Error {
+    /// A snapshot error saying `what` is wrong.
+    pub fn snapshot(what: impl Into<String>) -> Self {
+        Error::Snapshot { what: what.into() }
+    }
+
     /// A validation error for `field`.
     pub fn invalid(field: impl Into<String>, reason: impl Into<String>) -> Self {
         Error::InvalidField {
@@ -139,8 +151,10 @@ impl Error {
                 field: join(field),
                 id,
             },
-            failed
-            @ (Error::Unstable(_) | Error::TooManyContacts(_) | Error::CallbackFailed(_)) => failed,
+            other @ (Error::Unstable(_)
+            | Error::TooManyContacts(_)
+            | Error::CallbackFailed(_)
+            | Error::Snapshot { .. }) => other,
         }
     }
 
@@ -149,6 +163,7 @@ impl Error {
         match self {
             Error::InvalidField { field, .. } | Error::UnknownBody { field, .. } => field,
             Error::Unstable(_) | Error::CallbackFailed(_) => "",
+            Error::Snapshot { .. } => "snapshot",
             Error::TooManyContacts(_) => "max_contacts",
         }
     }

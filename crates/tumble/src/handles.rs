@@ -166,3 +166,59 @@ mod tests {
         }
     }
 }
+
+crate::codec::codec_struct!(Slot { generation, dense });
+
+impl<H: Handle> crate::codec::Code for Handles<H> {
+    fn put(&self, w: &mut crate::codec::Writer) {
+        self.slots.put(w);
+        self.free.put(w);
+        w.len(self.ids.len());
+        for id in &self.ids {
+            id.index().put(w);
+            id.generation().put(w);
+        }
+    }
+    fn get(r: &mut crate::codec::Reader<'_>) -> crate::codec::Decoded<Self> {
+        use crate::codec::Code;
+        let slots: Vec<Slot> = Code::get(r)?;
+        let free: Vec<u32> = Code::get(r)?;
+        let n = r.len()?;
+        let mut ids = Vec::with_capacity(n);
+        for _ in 0..n {
+            ids.push(H::from_parts(Code::get(r)?, Code::get(r)?));
+        }
+        let handles = Handles { slots, free, ids };
+        if !handles.consistent() {
+            let at = r.offset();
+            return Err(crate::error::Error::snapshot(format!(
+                "handles ending at byte {at} do not match their slots"
+            )));
+        }
+        Ok(handles)
+    }
+}
+
+impl<H: Handle> Handles<H> {
+    /// How many items are live.
+    pub(crate) fn len(&self) -> usize {
+        self.ids.len()
+    }
+
+    /// Whether every live handle names a slot of its generation that points back at it,
+    /// and every free slot is free: what a snapshot must hold before it is trusted.
+    fn consistent(&self) -> bool {
+        let live = self.ids.iter().enumerate().all(|(i, id)| {
+            self.slots
+                .get(id.index() as usize)
+                .is_some_and(|s| s.generation == id.generation() && s.dense == Some(i as u32))
+        });
+        let free = self.free.iter().all(|&f| {
+            self.slots
+                .get(f as usize)
+                .is_some_and(|s| s.dense.is_none())
+        });
+        let taken = self.slots.iter().filter(|s| s.dense.is_some()).count();
+        live && free && taken == self.ids.len()
+    }
+}

@@ -14,6 +14,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub(crate) mod codec;
 pub mod collision;
 pub mod dynamics;
 pub mod error;

@@ -160,3 +160,9 @@ mod tests {
 
     use crate::math::Real;
 }
+
+crate::codec::codec_struct!(SpeedLimits {
+    max_speed,
+    max_angular_speed
+});
+crate::codec::codec_struct!(ContactLimits { per_body, per_step });

@@ -749,6 +749,22 @@ class World:
         """Energies, momentum and angular momentum of the current state."""
     def state_hash(self) -> int:
         """Equal hashes mean bit-identical states."""
+    def snapshot(self) -> bytes:
+        """The world's whole state as bytes; restore/from_snapshot continue it bit-identically.
+        Force callbacks, the contact filter and modifier are code: not saved."""
+    def restore(self, data: bytes) -> None:
+        """Replaces the state with a snapshot; ValueError `snapshot: ...` changes nothing."""
+    @staticmethod
+    def from_snapshot(data: bytes) -> World:
+        """A new world continuing a snapshot (one taken without force callbacks)."""
+    def save_scene(self, path: Union[str, PathLike[str]], *, state: bool = True) -> None:
+        """Writes the world as a scene file; with state, World.from_scene continues it
+        bit-identically."""
+    @staticmethod
+    def _from_pickle(data: bytes, dt: float, duration: float) -> World: ...
+    def __reduce__(self) -> tuple[object, tuple[bytes, float, float]]: ...
+    def __copy__(self) -> World: ...
+    def __deepcopy__(self, memo: object) -> World: ...
 
 class Push:
     """An impulse a character's move gave a dynamic body in its way."""

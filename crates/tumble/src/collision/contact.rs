@@ -159,3 +159,32 @@ pub struct ContactEvent {
     /// The second body.
     pub body_b: BodyId,
 }
+
+crate::codec::codec_struct!(Contact {
+    body_a,
+    body_b,
+    manifold,
+    index_a,
+    index_b,
+    basis,
+    new,
+    gate,
+    edited
+});
+crate::codec::codec_struct!(ContactMaterial {
+    friction,
+    restitution,
+    surface_velocity
+});
+crate::codec::codec_unit_enum!(Gate { New, Keep, Pass });
+crate::codec::codec_struct!(Basis {
+    relative,
+    normal,
+    points
+});
+crate::codec::codec_unit_enum!(ContactEventKind { Begin, End });
+crate::codec::codec_struct!(ContactEvent {
+    kind,
+    body_a,
+    body_b
+});

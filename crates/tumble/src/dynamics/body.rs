@@ -304,6 +304,10 @@ impl Body {
     pub fn pose(&self) -> crate::collision::geometry::Pose {
         crate::collision::geometry::Pose::new(self.position(), self.orientation)
     }
+    /// Whether the body is a bullet (swept against moving bodies too).
+    pub fn is_bullet(&self) -> bool {
+        self.bullet
+    }
     /// False while the body's island sleeps.
     pub fn is_awake(&self) -> bool {
         self.awake
@@ -729,3 +733,47 @@ fn ccd_extent(shape: &Shape) -> Real {
             .min_element(),
     }
 }
+
+crate::codec::codec_unit_enum!(BodyKind {
+    Static,
+    Kinematic,
+    Dynamic
+});
+crate::codec::codec_struct!(Body {
+    name,
+    kind,
+    shape,
+    planar,
+    filter,
+    friction,
+    restitution,
+    rolling_resistance,
+    torsional_friction,
+    bullet,
+    linear_damping,
+    angular_damping,
+    gravity_scale,
+    sensor,
+    one_way,
+    kinematic_target,
+    ccd_extent,
+    ccd_reach,
+    awake,
+    sleep_time,
+    island_tag,
+    mass,
+    inv_mass,
+    local_center,
+    inertia_local,
+    inv_inertia_local,
+    principal_moments,
+    principal_axes,
+    principal_rotation,
+    isotropic,
+    planar_inertia,
+    com,
+    orientation,
+    velocity,
+    angular_momentum,
+    angular_velocity
+});

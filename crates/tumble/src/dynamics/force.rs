@@ -408,3 +408,64 @@ pub(crate) fn spring_potential(
         })
         .sum()
 }
+
+crate::codec::codec_struct!(Spring {
+    body,
+    anchor,
+    other,
+    stiffness,
+    rest_length,
+    damping
+});
+crate::codec::codec_struct!(Drag {
+    body,
+    linear,
+    quadratic
+});
+crate::codec::codec_struct!(AppliedForce {
+    body,
+    force,
+    point,
+    torque
+});
+
+impl crate::codec::Code for SpringEnd {
+    fn put(&self, w: &mut crate::codec::Writer) {
+        match self {
+            SpringEnd::World(p) => (0u8, *p).put(w),
+            SpringEnd::Body { body, anchor } => (1u8, (*body, *anchor)).put(w),
+        }
+    }
+
+    fn get(r: &mut crate::codec::Reader<'_>) -> crate::codec::Decoded<Self> {
+        use crate::codec::Code;
+        Ok(match u8::get(r)? {
+            0 => SpringEnd::World(Code::get(r)?),
+            1 => {
+                let (body, anchor) = Code::get(r)?;
+                SpringEnd::Body { body, anchor }
+            }
+            t => return Err(r.bad_tag("spring end", t)),
+        })
+    }
+}
+
+impl crate::codec::Code for Force {
+    fn put(&self, w: &mut crate::codec::Writer) {
+        match self {
+            Force::Spring(s) => (0u8, *s).put(w),
+            Force::Drag(d) => (1u8, *d).put(w),
+            Force::Applied(a) => (2u8, *a).put(w),
+        }
+    }
+
+    fn get(r: &mut crate::codec::Reader<'_>) -> crate::codec::Decoded<Self> {
+        use crate::codec::Code;
+        Ok(match u8::get(r)? {
+            0 => Force::Spring(Code::get(r)?),
+            1 => Force::Drag(Code::get(r)?),
+            2 => Force::Applied(Code::get(r)?),
+            t => return Err(r.bad_tag("force", t)),
+        })
+    }
+}

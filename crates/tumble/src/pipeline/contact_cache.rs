@@ -895,3 +895,12 @@ fn warm_start(contact: &mut Contact, previous: &Sorted<'_>, poses: (&Pose, &Pose
 
 /// How close an unnamed point must be to last step's to inherit its impulses (m).
 const MATCH_DISTANCE: Real = 0.01;
+
+// Between steps a cache is its contacts, touching pairs and events (and the counts the
+// next update reads); `previous` and the `_before` lists are overwritten by the next
+// update before anything reads them, and the rest is scratch.
+crate::codec::codec_struct!(ContactCache {
+    contacts, touching, events, crowded, overflowed, collided;
+    previous, order, keys, keyed, events_before, pairs, touching_before, scratch, degree,
+    pieces, motions
+});

@@ -395,3 +395,19 @@ fn holds(p: &Body, o: &Body, out: Vec3, at: Vec3, rule: &OneWayRule) -> bool {
     let after = v + rule.kick * (fall(o) - fall(p));
     v.dot(n).min(after.dot(n)) <= rule.speed
 }
+
+crate::codec::codec_struct!(Verdicts { list, next });
+// The filter and modifier are code: the world restored into keeps its own (see
+// `pipeline/world/snapshot.rs`).
+crate::codec::codec_struct!(Hooks {
+    verdicts, sensor_verdicts, one_way_bodies, materials, passing;
+    filter, modifier
+});
+
+impl Hooks {
+    /// Takes `other`'s contact filter and modifier (code, which snapshots do not hold).
+    pub(crate) fn take_code(&mut self, other: &mut Hooks) {
+        self.filter = other.filter.take();
+        self.modifier = other.modifier.take();
+    }
+}

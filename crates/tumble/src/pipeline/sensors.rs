@@ -189,3 +189,14 @@ fn changes(
         }
     }
 }
+
+crate::codec::codec_struct!(SensorEvent {
+    sensor,
+    body,
+    began,
+    time
+});
+crate::codec::codec_struct!(SensorStore {
+    sensor_bodies, overlaps, events, pending;
+    found, candidates, stack, manifolds
+});

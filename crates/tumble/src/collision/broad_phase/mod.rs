@@ -708,3 +708,37 @@ fn merge(a: &[PairEntry], b: &[PairEntry], out: &mut Vec<PairEntry>) {
     out.extend_from_slice(&a[i..]);
     out.extend_from_slice(&b[j..]);
 }
+
+impl crate::codec::Code for ProxyId {
+    fn put(&self, w: &mut crate::codec::Writer) {
+        self.0.put(w);
+    }
+    fn get(r: &mut crate::codec::Reader<'_>) -> crate::codec::Decoded<Self> {
+        Ok(ProxyId(crate::codec::Code::get(r)?))
+    }
+}
+crate::codec::codec_unit_enum!(ProxyKind { Static, Moving });
+crate::codec::codec_struct!(Filter { group, mask });
+crate::codec::codec_struct!(Proxy {
+    user,
+    kind,
+    filter,
+    node,
+    next_free
+});
+crate::codec::codec_struct!(PairEntry { users, a, b });
+crate::codec::codec_struct!(Crowding { sunk, any, depth });
+crate::codec::codec_struct!(Crowd {
+    caps,
+    tight,
+    degree,
+    crowded,
+    engaged,
+    live,
+    requery,
+    lost
+});
+crate::codec::codec_struct!(BroadPhase {
+    margin, proxies, free, count, trees, move_buffer, moved, pairs, crowd;
+    found, merged, stack, pair_stack, pending
+});

@@ -555,3 +555,16 @@ impl Tree {
         Ok(())
     }
 }
+
+crate::codec::codec_struct!(Node {
+    aabb,
+    parent,
+    children,
+    height
+});
+crate::codec::codec_struct!(Tree {
+    nodes,
+    root,
+    free,
+    leaves
+});

@@ -160,3 +160,5 @@ impl Aabb {
         Some((t0, t1))
     }
 }
+
+crate::codec::codec_struct!(Aabb { min, max });

@@ -78,3 +78,5 @@ impl Pose {
         }
     }
 }
+
+crate::codec::codec_struct!(Pose { position, rotation });

@@ -272,3 +272,33 @@ pub fn reduce(candidates: &[Candidate], margin: Real, out: &mut Manifold) {
         }
     }
 }
+
+crate::codec::codec_struct!(ContactPoint {
+    point_a,
+    point_b,
+    separation,
+    feature,
+    normal_impulse,
+    tangent_impulse,
+    total_normal_impulse,
+    total_tangent_impulse,
+    anchor_a,
+    anchor_b,
+    anchored,
+    sliding
+});
+crate::codec::codec_unit_enum!(Overlap {
+    New,
+    Recovering,
+    Clear
+});
+crate::codec::codec_struct!(Manifold {
+    normal,
+    subshape_a,
+    subshape_b,
+    angular_impulse,
+    overlap,
+    fine,
+    points,
+    count
+});

@@ -372,3 +372,11 @@ mod tests {
         assert_eq!(f.height_at(0.5, 0.0), Some(3.0));
     }
 }
+
+crate::codec::codec_struct!(HeightField {
+    heights,
+    rows,
+    cols,
+    scale,
+    range
+});

@@ -269,3 +269,79 @@ impl Shape {
         }
     }
 }
+
+crate::codec::codec_struct!(CompoundChild {
+    shape,
+    position,
+    orientation
+});
+
+impl crate::codec::Code for Shape {
+    fn put(&self, w: &mut crate::codec::Writer) {
+        match self {
+            Shape::Sphere { radius } => (0u8, *radius).put(w),
+            Shape::Box { half_extents } => (1u8, *half_extents).put(w),
+            Shape::Capsule {
+                radius,
+                half_height,
+            } => (2u8, (*radius, *half_height)).put(w),
+            Shape::Cylinder {
+                radius,
+                half_height,
+            } => (3u8, (*radius, *half_height)).put(w),
+            Shape::ConvexHull(hull) => {
+                4u8.put(w);
+                hull.put(w);
+            }
+            Shape::Compound(children) => {
+                5u8.put(w);
+                children.put(w);
+            }
+            Shape::Plane { normal, offset } => (6u8, (*normal, *offset)).put(w),
+            Shape::TriMesh(mesh) => {
+                7u8.put(w);
+                mesh.put(w);
+            }
+            Shape::HeightField(field) => {
+                8u8.put(w);
+                field.put(w);
+            }
+        }
+    }
+
+    fn get(r: &mut crate::codec::Reader<'_>) -> crate::codec::Decoded<Self> {
+        use crate::codec::Code;
+        let get_pair = |r: &mut crate::codec::Reader<'_>| <(Real, Real)>::get(r);
+        Ok(match u8::get(r)? {
+            0 => Shape::Sphere {
+                radius: Code::get(r)?,
+            },
+            1 => Shape::Box {
+                half_extents: Code::get(r)?,
+            },
+            2 => {
+                let (radius, half_height) = get_pair(r)?;
+                Shape::Capsule {
+                    radius,
+                    half_height,
+                }
+            }
+            3 => {
+                let (radius, half_height) = get_pair(r)?;
+                Shape::Cylinder {
+                    radius,
+                    half_height,
+                }
+            }
+            4 => Shape::ConvexHull(Code::get(r)?),
+            5 => Shape::Compound(Code::get(r)?),
+            6 => {
+                let (normal, offset) = Code::get(r)?;
+                Shape::Plane { normal, offset }
+            }
+            7 => Shape::TriMesh(Code::get(r)?),
+            8 => Shape::HeightField(Code::get(r)?),
+            t => return Err(r.bad_tag("shape", t)),
+        })
+    }
+}

@@ -333,3 +333,21 @@ fn move_kinematic(bodies: &[Body], motions: &mut [Motion], dt: Real) {
 
 pub(crate) use rotation::{drift as rotor_drift, exact_spin};
 use symplectic::VerletMemory;
+
+crate::codec::codec_unit_enum!(Integrator {
+    ExplicitEuler,
+    SymplecticEuler,
+    ImplicitEuler,
+    Midpoint,
+    Rk4,
+    Verlet,
+    VelocityVerlet
+});
+crate::codec::codec_struct!(IntegratorMemory { verlet });
+
+impl IntegratorMemory {
+    /// How many bodies the memory has a slot for (one per body).
+    pub(crate) fn slots(&self) -> usize {
+        self.verlet.len()
+    }
+}

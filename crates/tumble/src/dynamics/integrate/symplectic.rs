@@ -149,3 +149,9 @@ pub(super) fn verlet(
         refresh_omega(body, m);
     }
 }
+
+crate::codec::codec_struct!(VerletMemory {
+    x_previous,
+    l_half,
+    dt
+});

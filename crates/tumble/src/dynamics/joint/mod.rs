@@ -378,3 +378,118 @@ pub(crate) fn build(def: &JointDef, body: (Vec3, Quat), other: Option<(Vec3, Qua
         impulses: JointImpulses::default(),
     }
 }
+
+crate::codec::codec_struct!(Motor { speed, max_force });
+crate::codec::codec_struct!(JointSpring {
+    hertz,
+    damping_ratio,
+    target
+});
+crate::codec::codec_struct!(Servo {
+    target,
+    stiffness,
+    damping,
+    max_force
+});
+crate::codec::codec_struct!(JointDef {
+    name,
+    kind,
+    body,
+    anchor,
+    axis,
+    other,
+    other_anchor,
+    other_axis,
+    collide_connected,
+    break_force
+});
+crate::codec::codec_struct!(Joint {
+    def,
+    axis,
+    other_axis,
+    reference,
+    other_reference,
+    relative_rotation,
+    length,
+    broken,
+    enabled,
+    reaction_force,
+    reaction_torque,
+    impulses
+});
+crate::codec::codec_struct!(JointImpulses {
+    hard,
+    lower,
+    upper,
+    cone,
+    motor,
+    spring,
+    servo,
+    axial
+});
+
+impl crate::codec::Code for JointKind {
+    fn put(&self, w: &mut crate::codec::Writer) {
+        match *self {
+            JointKind::Ball { cone, twist } => (0u8, (cone, twist)).put(w),
+            JointKind::Hinge {
+                limits,
+                motor,
+                spring,
+                servo,
+            } => (1u8, (limits, motor, spring, servo)).put(w),
+            JointKind::Slider {
+                limits,
+                motor,
+                spring,
+                servo,
+            } => (2u8, (limits, motor, spring, servo)).put(w),
+            JointKind::Fixed => 3u8.put(w),
+            JointKind::Distance {
+                length,
+                min,
+                max,
+                spring,
+            } => (4u8, (length, min, max, spring)).put(w),
+        }
+    }
+
+    fn get(r: &mut crate::codec::Reader<'_>) -> crate::codec::Decoded<Self> {
+        use crate::codec::Code;
+        Ok(match u8::get(r)? {
+            0 => {
+                let (cone, twist) = Code::get(r)?;
+                JointKind::Ball { cone, twist }
+            }
+            tag @ (1 | 2) => {
+                let (limits, motor, spring, servo) = Code::get(r)?;
+                if tag == 1 {
+                    JointKind::Hinge {
+                        limits,
+                        motor,
+                        spring,
+                        servo,
+                    }
+                } else {
+                    JointKind::Slider {
+                        limits,
+                        motor,
+                        spring,
+                        servo,
+                    }
+                }
+            }
+            3 => JointKind::Fixed,
+            4 => {
+                let (length, min, max, spring) = Code::get(r)?;
+                JointKind::Distance {
+                    length,
+                    min,
+                    max,
+                    spring,
+                }
+            }
+            t => return Err(r.bad_tag("joint kind", t)),
+        })
+    }
+}

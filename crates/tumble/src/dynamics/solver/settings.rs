@@ -160,3 +160,20 @@ pub(super) fn bias_rule(settings: &SolverSettings, scales: &Scales, time: &StepT
         stiffened: false,
     }
 }
+
+crate::codec::codec_unit_enum!(SolverKind { SoftStep, Pgs });
+crate::codec::codec_struct!(SolverSettings {
+    kind,
+    substeps,
+    iterations,
+    contact_hertz,
+    contact_damping_ratio,
+    baumgarte,
+    joint_hertz,
+    joint_damping_ratio
+});
+crate::codec::codec_struct!(Scales {
+    linear_slop,
+    max_push,
+    restitution_threshold
+});

@@ -32,6 +32,7 @@ mod joint_edit;
 mod joints;
 mod properties;
 pub mod query;
+mod snapshot;
 pub(crate) mod step;
 
 use crate::collision::broad_phase::{BroadPhase, ProxyId};
@@ -145,6 +146,8 @@ impl Tolerances {
 pub(crate) struct Settings {
     pub gravity: Vec3,
     pub integrator: Integrator,
+    /// The scene's length scale (m), which `tolerances` were derived from.
+    pub length_unit: Real,
     pub tolerances: Tolerances,
     pub solver: SolverSettings,
     pub sleep: bool,
@@ -273,6 +276,7 @@ impl World {
             settings: Settings {
                 gravity: def.gravity,
                 integrator: def.integrator,
+                length_unit: unit,
                 tolerances,
                 solver: def.solver,
                 sleep: def.sleep,
@@ -429,6 +433,12 @@ impl World {
         self.clock.steps
     }
 
+    /// The length scale the world's tolerances were derived from (m; see
+    /// [`WorldDef::length_unit`]).
+    pub fn length_unit(&self) -> Real {
+        self.settings.length_unit
+    }
+
     /// Speculative contact distance (m).
     pub fn contact_margin(&self) -> Real {
         self.settings.tolerances.contact_margin
@@ -546,3 +556,33 @@ impl World {
         diagnostics::state_hash(&self.bodies.list)
     }
 }
+
+crate::codec::codec_struct!(Tolerances {
+    contact_margin,
+    aabb_margin,
+    scales,
+    sleep_speed
+});
+crate::codec::codec_struct!(Settings {
+    gravity,
+    integrator,
+    length_unit,
+    tolerances,
+    solver,
+    sleep,
+    limits,
+    contacts
+});
+crate::codec::codec_struct!(Clock { time, steps });
+crate::codec::codec_struct!(BodyStore { list, handles });
+crate::codec::codec_struct!(JointStore {
+    list,
+    handles,
+    links,
+    joined_pairs
+});
+crate::codec::codec_struct!(CollisionStore {
+    broad_phase,
+    proxies,
+    contacts
+});

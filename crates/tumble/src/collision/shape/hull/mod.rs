@@ -205,3 +205,11 @@ fn tri_plane(pts: &[DVec3], t: [usize; 3]) -> (DVec3, f64) {
     let centroid = (pts[t[0]] + pts[t[1]] + pts[t[2]]) / 3.0;
     (n, n.dot(centroid))
 }
+
+crate::codec::codec_struct!(ConvexHull {
+    vertices,
+    triangles,
+    planes,
+    face_loops,
+    edges
+});

@@ -482,3 +482,15 @@ pub(crate) fn aabb_distance_squared(b: &Aabb, p: Vec3) -> Real {
     let q = p.clamp(b.min, b.max);
     (q - p).length_squared()
 }
+
+crate::codec::codec_struct!(Node { aabb, first, count });
+crate::codec::codec_struct!(TriMesh {
+    vertices,
+    indices,
+    normals,
+    neighbors,
+    bends,
+    bounds,
+    nodes,
+    order
+});
