@@ -160,7 +160,7 @@ pub fn load(name_or_path: &str) -> Result<Scene> {
     match builtin(name_or_path) {
         Some(json) => load_str(json),
         // MJCF models (MuJoCo XML) by extension; see `mjcf`.
-        None if mjcf::is_mjcf(name_or_path) => mjcf::load_scene(name_or_path),
+        None if mjcf::is_mjcf(name_or_path) => mjcf::load_scene(name_or_path).map(|(s, _)| s),
         None if Path::new(name_or_path).exists() => load_file(name_or_path),
         None => Err(SceneError::new(
             ROOT,

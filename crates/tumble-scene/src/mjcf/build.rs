@@ -74,6 +74,9 @@ struct Ctx<'a> {
     /// Pairs that must not collide though no joint joins them directly.
     excluded: Vec<(usize, usize)>,
     unnamed_joints: usize,
+    /// From `<option><flag>`: whether joint ranges limit, and springs and dampers act.
+    limits: bool,
+    passive: bool,
 }
 
 /// Reads the tree and builds it into `world`.
@@ -89,11 +92,15 @@ pub(crate) fn build(root: &Elem, world: &mut World, options: &MjcfOptions) -> Re
         names: Vec::new(),
         excluded: Vec::new(),
         unnamed_joints: 0,
+        limits: true,
+        passive: true,
     };
     for c in root.kids("compiler") {
         ctx.compiler.read(&View::new(c, MAIN, &defaults)?)?;
     }
     let settings = read_options(root, &defaults, &mut ctx.warn)?;
+    ctx.limits = settings.limits;
+    ctx.passive = settings.passive;
     ctx.bodies.push(PlanBody {
         name: Some("world".to_string()),
         label: "world".to_string(),
@@ -132,6 +139,12 @@ pub(crate) struct Settings {
     pub timestep: Real,
     pub gravity: Vec3,
     pub integrator: Integrator,
+    /// `<flag contact="disable">` (or `constraint`): no body collides with any other.
+    pub contacts: bool,
+    /// `<flag limit="disable">` (or `constraint`): joint ranges are not limits.
+    pub limits: bool,
+    /// `<flag passive="disable">`: no joint springs or dampers.
+    pub passive: bool,
 }
 
 fn read_options(root: &Elem, defaults: &Defaults, warn: &mut Warnings) -> Result<Settings> {
@@ -139,6 +152,9 @@ fn read_options(root: &Elem, defaults: &Defaults, warn: &mut Warnings) -> Result
         timestep: 0.002,
         gravity: Vec3::new(0.0, 0.0, -9.81),
         integrator: Integrator::SymplecticEuler,
+        contacts: true,
+        limits: true,
+        passive: true,
     };
     for o in root.kids("option") {
         let v = View::new(o, MAIN, defaults)?;
@@ -172,8 +188,31 @@ fn read_options(root: &Elem, defaults: &Defaults, warn: &mut Warnings) -> Result
                 warn.add(o, &format!("option {key}: not read"));
             }
         }
+        for flag in o.kids("flag") {
+            read_flags(flag, &mut s, warn);
+        }
     }
     Ok(s)
+}
+
+/// `<option><flag>`: the switches that change what is simulated.
+fn read_flags(flag: &Elem, s: &mut Settings, warn: &mut Warnings) {
+    for (key, value) in &flag.attrs {
+        let off = value == "disable";
+        match key.as_str() {
+            "contact" => s.contacts &= !off,
+            "limit" => s.limits &= !off,
+            "passive" => s.passive &= !off,
+            "constraint" => {
+                s.contacts &= !off;
+                s.limits &= !off;
+            }
+            "gravity" if off => s.gravity = Vec3::ZERO,
+            // Reporting and solver details with nothing to map to.
+            "energy" | "warmstart" | "gravity" => {}
+            other => warn.add(flag, &format!("option flag {other}: not read")),
+        }
+    }
 }
 
 /// Sections with no physics the import reads, or none at all.
@@ -416,9 +455,12 @@ fn joint(ctx: &mut Ctx<'_>, v: &View<'_>, body: usize, other: usize) -> Result<P
         .try_normalize()
         .ok_or_else(|| v.err("axis", "must not be zero"))?;
     let reference = unit(v.real("ref")?.unwrap_or(0.0));
-    let range = joint_range(v, c)?.map(|[lo, hi]| [unit(lo) - reference, unit(hi) - reference]);
-    let stiffness = non_negative(v, "stiffness")?;
-    let damping = non_negative(v, "damping")?;
+    let range = joint_range(v, c)?
+        .filter(|_| ctx.limits)
+        .map(|[lo, hi]| [unit(lo) - reference, unit(hi) - reference]);
+    let passive = if ctx.passive { 1.0 } else { 0.0 };
+    let stiffness = non_negative(v, "stiffness")? * passive;
+    let damping = non_negative(v, "damping")? * passive;
     let springref = unit(v.real("springref")?.unwrap_or(0.0));
     for key in ["armature", "frictionloss"] {
         if non_negative(v, key)? > 0.0 {

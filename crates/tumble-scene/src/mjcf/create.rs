@@ -59,7 +59,11 @@ struct Ids {
 }
 
 fn create_all(plan: &Plan, world: &mut World, made: &mut Made) -> Result<Ids> {
-    let filters = filters(plan);
+    let filters = if plan.settings.contacts {
+        filters(plan)
+    } else {
+        vec![(0, 0); plan.bodies.len()]
+    };
     let mut bodies = Vec::with_capacity(plan.bodies.len());
     for (i, b) in plan.bodies.iter().enumerate() {
         let id = create_body(plan, b, filters[i], world, made)?;

@@ -170,8 +170,8 @@ pub fn load(path: impl AsRef<Path>, world: &mut World, options: &MjcfOptions) ->
 }
 
 /// A scene of one model: a world with the file's gravity (default (0, 0, −9.81): MJCF is
-/// z-up), integrator and timestep, run for 1 s.
-pub fn load_scene(path: impl AsRef<Path>) -> Result<Scene> {
+/// z-up), integrator and timestep, run for 1 s; with what the import made of the file.
+pub fn load_scene(path: impl AsRef<Path>) -> Result<(Scene, ImportedMjcf)> {
     let def = WorldDef {
         gravity: Vec3::new(0.0, 0.0, -9.81),
         ..WorldDef::default()
@@ -191,7 +191,7 @@ pub fn load_scene(path: impl AsRef<Path>) -> Result<Scene> {
         })
         .collect();
     let body_colors = model.colors.iter().map(|c| c.1).collect();
-    Ok(Scene {
+    let scene = Scene {
         name: model.model.clone(),
         description: None,
         world,
@@ -200,7 +200,8 @@ pub fn load_scene(path: impl AsRef<Path>) -> Result<Scene> {
         body_names,
         body_colors,
         character: None,
-    })
+    };
+    Ok((scene, model))
 }
 
 /// Whether a path names an MJCF file (by its `.xml` extension).
