@@ -38,6 +38,14 @@ def mujoco_run(path, qpos0):
     return names, np.array(out)
 
 
+def difference(ours, reference, hinges):
+    """Largest difference; hinge angles compared modulo 2 pi (Tumble reads them in
+    (-pi, pi], MuJoCo's qpos counts whole turns)."""
+    d = ours - reference
+    d[:, hinges] = (d[:, hinges] + np.pi) % (2 * np.pi) - np.pi
+    return np.abs(d).max()
+
+
 def tumble_run(path, names, qpos0):
     world = tumble.World.from_mjcf(path)
     # MuJoCo's qpos joint by joint (ref is 0 in these files): parents first.
@@ -65,19 +73,20 @@ def tumble_run(path, names, qpos0):
 def test_passive_motion_matches_mujoco(path, qpos0):
     names, reference = mujoco_run(path, qpos0)
     ours = tumble_run(path, names, qpos0)
-    worst = np.abs(ours - reference).max()
+    worst = difference(ours, reference, [n != "slider" for n in names])
+    print(f"{path.name}: largest joint difference {worst:.2e} over 1 s")
     # Both integrate the same equations at dt = 1e-4 s; what differs is MuJoCo's
     # generalized coordinates against Tumble's constraints (their drift and softness).
     assert worst < 1e-2, f"largest joint difference {worst} rad or m"
-    # The motion is real: the joints swing by far more than the tolerance.
-    assert np.ptp(reference, axis=0).min() > 0.1
+    # The motion is real: every joint moves by 5 times the tolerance or more.
+    assert np.ptp(reference, axis=0).min() > 0.05
 
 
 def welded_to_world(model):
     return [model.body_weldid[i] == 0 for i in range(model.nbody)]
 
 
-@pytest.mark.parametrize("name", ["pendulum", "cartpole", "acrobot"])
+@pytest.mark.parametrize("name", ["pendulum", "cartpole", "acrobot", "finger", "reacher"])
 def test_suite_models_load_run_and_weigh_what_mujoco_says(name):
     path = SUITE / f"{name}.xml"
     model = mujoco.MjModel.from_xml_path(str(path))
@@ -87,14 +96,40 @@ def test_suite_models_load_run_and_weigh_what_mujoco_says(name):
     world = tumble.World.from_mjcf(path)
     ours = sum(b.mass for b in world.bodies if b.kind == "dynamic")
     assert ours == pytest.approx(sum(moving), rel=1e-12)
-    assert world.gravity.tolist() == pytest.approx(list(model.opt.gravity))
+    gravity_off = model.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_GRAVITY
+    expected = [0.0, 0.0, 0.0] if gravity_off else list(model.opt.gravity)
+    assert world.gravity.tolist() == pytest.approx(expected)
     for j in range(model.njnt):
-        assert world.joint(model.joint(j).name) is not None
+        joint = world.joint(model.joint(j).name)
+        if joint.kind == "hinge":
+            joint.position = 0.2  # off the upright (unstable) balance
     start = [b.position.copy() for b in world.bodies]
     world.step(float(model.opt.timestep), steps=int(round(1.0 / model.opt.timestep)))
     end = [b.position for b in world.bodies]
     assert all(np.isfinite(p).all() for p in end)
-    assert any(np.abs(a - b).max() > 1e-3 for a, b in zip(start, end)), "something moves"
+    if not gravity_off:
+        assert any(np.abs(a - b).max() > 1e-3 for a, b in zip(start, end)), "nothing fell"
+
+
+# Models with several joints in one body: Tumble adds a light body (1/1000 of the body's
+# mass) per extra joint, so their totals come out up to 0.3% heavier; dog reads no meshes.
+HEAVIER = ["ball_in_cup", "cheetah", "fish", "hopper", "humanoid", "humanoid_CMU",
+           "manipulator", "point_mass", "quadruped", "stacker", "swimmer", "walker"]
+
+
+@pytest.mark.parametrize("name", HEAVIER)
+def test_every_other_suite_model_loads_and_runs(name):
+    path = SUITE / f"{name}.xml"
+    model = mujoco.MjModel.from_xml_path(str(path))
+    moving = sum(m for m, w in zip(model.body_mass, welded_to_world(model)) if not w)
+    with pytest.warns(UserWarning, match="several joints in one body"):
+        world = tumble.World.from_mjcf(path)
+    light = [b.mass for b in world.bodies if b.kind == "dynamic" and b.name is None]
+    ours = sum(b.mass for b in world.bodies if b.kind == "dynamic")
+    assert ours - sum(light) == pytest.approx(moving, rel=1e-9)
+    assert 0 < sum(light) <= 3e-3 * moving
+    world.step(float(model.opt.timestep), steps=int(round(1.0 / model.opt.timestep)))
+    assert all(np.isfinite(b.position).all() for b in world.bodies)
 
 
 def test_a_damped_suite_pendulum_matches_mujoco():
@@ -102,7 +137,9 @@ def test_a_damped_suite_pendulum_matches_mujoco():
     path = SUITE / "pendulum.xml"
     names, reference = mujoco_run(path, [1.0])
     ours = tumble_run(path, names, [1.0])
-    assert np.abs(ours - reference).max() < 1e-2
+    worst = difference(ours, reference, [True])
+    print(f"suite pendulum: largest joint difference {worst:.2e} rad over 1 s")
+    assert worst < 1e-2
 
 
 def test_bad_files_raise_value_error_naming_file_and_line(tmp_path):

@@ -119,6 +119,9 @@ pub(crate) fn build(root: &Elem, world: &mut World, options: &MjcfOptions) -> Re
     exclusions(&mut ctx, root)?;
     let actuators = read_actuators(&mut ctx, root)?;
     let servos = servos(&ctx, &actuators);
+    if let Some(total) = ctx.compiler.total_mass {
+        scale_masses(&mut ctx.bodies, total);
+    }
     let plan = Plan {
         model: root.own("model").map(str::to_string),
         bodies: ctx.bodies,
@@ -132,6 +135,26 @@ pub(crate) fn build(root: &Elem, world: &mut World, options: &MjcfOptions) -> Re
         warnings: ctx.warn.list,
     };
     super::create::create(plan, world, options)
+}
+
+/// `<compiler settotalmass>`: every moving body's mass and inertia times one factor, so
+/// that they add up to `total`.
+fn scale_masses(bodies: &mut [PlanBody], total: Real) {
+    let now: Real = bodies
+        .iter()
+        .filter(|b| b.dynamic && b.light_of.is_none())
+        .flat_map(|b| b.mass.iter().map(|m| m.mass))
+        .sum();
+    if now <= 0.0 {
+        return;
+    }
+    let k = total / now;
+    for b in bodies.iter_mut().filter(|b| b.dynamic) {
+        for m in &mut b.mass {
+            m.mass *= k;
+            m.inertia *= k;
+        }
+    }
 }
 
 /// `<option>`: timestep, gravity, integrator.

@@ -28,6 +28,8 @@ pub(crate) struct Compiler {
     pub from_geom: FromGeom,
     /// A joint `range` limits it unless `limited="false"` (MuJoCo's default, `true`).
     pub autolimits: bool,
+    /// `settotalmass`: every moving body's mass and inertia scaled to this total (kg).
+    pub total_mass: Option<Real>,
 }
 
 impl Default for Compiler {
@@ -37,6 +39,7 @@ impl Default for Compiler {
             eulerseq: *b"xyz",
             from_geom: FromGeom::Auto,
             autolimits: true,
+            total_mass: None,
         }
     }
 }
@@ -80,6 +83,10 @@ impl Compiler {
         };
         if let Some(a) = v.flag("autolimits")? {
             self.autolimits = a;
+        }
+        if let Some(m) = v.real("settotalmass")? {
+            // MuJoCo: a value <= 0 (its default, -1) leaves the masses as they are.
+            self.total_mass = (m > 0.0).then_some(m);
         }
         if v.get("coordinate") == Some("global") {
             return Err(v.err("coordinate", "global coordinates are not supported"));
