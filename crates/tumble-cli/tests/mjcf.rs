@@ -4,7 +4,10 @@ use std::path::PathBuf;
 use std::process::{Command, Output};
 
 fn tumble(args: &[&str]) -> Output {
-    match Command::new(env!("CARGO_BIN_EXE_tumble")).args(args).output() {
+    match Command::new(env!("CARGO_BIN_EXE_tumble"))
+        .args(args)
+        .output()
+    {
         Ok(out) => out,
         Err(e) => panic!("cannot start tumble: {e}"),
     }
@@ -20,11 +23,34 @@ fn model(name: &str) -> String {
 
 #[test]
 fn an_mjcf_model_runs_with_its_bodies_named() {
-    let out = tumble(&["run", &model("cartpole.xml"), "--steps", "20", "--quiet"]);
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    // One row per body and recorded step, labelled with the file's body names.
-    assert!(text.contains("pole") && text.contains("cart"), "{text}");
+    let dir = std::env::temp_dir().join(format!("tumble-cli-mjcf-run-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("cartpole.csv");
+    let out = tumble(&[
+        "run",
+        &model("cartpole.xml"),
+        "--steps",
+        "20",
+        "--quiet",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    // A row per body per recorded step, labelled with the file's body names; the file's
+    // timestep (1 ms) is the run's dt.
+    let last = text.lines().last().unwrap();
+    assert!(last.starts_with("0.02"), "{last}");
+    for name in ["cart", "pole"] {
+        assert!(
+            text.lines().any(|l| l.split(',').nth(1) == Some(name)),
+            "{text}"
+        );
+    }
 }
 
 #[test]
@@ -32,10 +58,17 @@ fn a_bad_mjcf_model_is_one_line_and_exit_2() {
     let dir = std::env::temp_dir().join(format!("tumble-cli-mjcf-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("bad.xml");
-    std::fs::write(&path, "<mujoco>\n<worldbody>\n<geom size=\"0\"/>\n</worldbody>\n</mujoco>").unwrap();
+    std::fs::write(
+        &path,
+        "<mujoco>\n<worldbody>\n<geom size=\"0\"/>\n</worldbody>\n</mujoco>",
+    )
+    .unwrap();
     let out = tumble(&["run", path.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(err.starts_with("bad.xml:3: <geom>: size: must be > 0"), "{err}");
+    assert!(
+        err.starts_with("bad.xml:3: <geom>: size: must be > 0"),
+        "{err}"
+    );
 }

@@ -50,7 +50,10 @@ fn close(a: Real, b: Real, rel: Real) -> bool {
 }
 
 fn mat_close(a: Mat3, b: Mat3, rel: Real) -> bool {
-    let scale = b.to_cols_array().iter().fold(0.0 as Real, |m, x| m.max(x.abs()));
+    let scale = b
+        .to_cols_array()
+        .iter()
+        .fold(0.0 as Real, |m, x| m.max(x.abs()));
     a.to_cols_array()
         .iter()
         .zip(b.to_cols_array())
@@ -78,7 +81,11 @@ fn capsule_links_have_the_closed_form_mass_centre_and_inertia() {
     ] {
         let body = world.body(m.body(name).unwrap()).unwrap();
         let (mass, inertia) = capsule_x(1000.0, r, l);
-        assert!(close(body.mass(), mass, EXACT), "{name}: {} vs {mass}", body.mass());
+        assert!(
+            close(body.mass(), mass, EXACT),
+            "{name}: {} vs {mass}",
+            body.mass()
+        );
         assert!((body.local_center_of_mass() - Vec3::new(l / 2.0, 0.0, 0.0)).length() < EXACT);
         assert!(
             mat_close(body.inertia_local(), inertia, EXACT),
@@ -87,7 +94,11 @@ fn capsule_links_have_the_closed_form_mass_centre_and_inertia() {
         );
         assert!((body.position() - origin).length() < EXACT);
     }
-    assert_eq!(world.body_count(), 2, "no static body: the world has no geoms");
+    assert_eq!(
+        world.body_count(),
+        2,
+        "no static body: the world has no geoms"
+    );
     let names: Vec<&str> = m.joints.iter().map(|j| j.name.as_str()).collect();
     assert_eq!(names, ["shoulder", "elbow"]);
     assert_eq!(world.integrator(), tumble::Integrator::Rk4);
@@ -108,7 +119,10 @@ fn every_orientation_form_gives_the_same_turn() {
         );
     }
     // zaxis fixes only where z goes (the shortest turn there).
-    let q = world.body(m.body("by_zaxis").unwrap()).unwrap().orientation();
+    let q = world
+        .body(m.body("by_zaxis").unwrap())
+        .unwrap()
+        .orientation();
     assert!((q * Vec3::Z - Vec3::X).length() < 1e-6);
     let free = m.joints.iter().filter(|j| j.kind == "free").count();
     assert_eq!(free, 5);
@@ -133,14 +147,22 @@ fn default_classes_inherit_and_childclass_passes_down() {
     assert!((parent.local_center_of_mass() - com).length() < EXACT);
     // The tensor about the joint centre: both boxes' own plus the parallel-axis terms.
     let own = |m: Real, h: Vec3| {
-        Vec3::new(h.y * h.y + h.z * h.z, h.x * h.x + h.z * h.z, h.x * h.x + h.y * h.y) * (m / 3.0)
+        Vec3::new(
+            h.y * h.y + h.z * h.z,
+            h.x * h.x + h.z * h.z,
+            h.x * h.x + h.y * h.y,
+        ) * (m / 3.0)
     };
     let d1 = com.x;
     let d2 = 1.0 - com.x;
     let i = own(m1, Vec3::new(0.1, 0.2, 0.3))
         + own(m2, Vec3::splat(0.1))
         + Vec3::new(0.0, 1.0, 1.0) * (m1 * d1 * d1 + m2 * d2 * d2);
-    assert!(mat_close(parent.inertia_local(), Mat3::from_diagonal(i), EXACT));
+    assert!(mat_close(
+        parent.inertia_local(),
+        Mat3::from_diagonal(i),
+        EXACT
+    ));
     assert_eq!(world.body_count(), 4);
 }
 
@@ -152,7 +174,11 @@ fn inertial_elements_set_mass_centre_and_full_tensor() {
     assert!((diag.local_center_of_mass() - Vec3::new(0.1, 0.2, 0.3)).length() < EXACT);
     // diaginertia in a frame turned 90° about z: x and y moments swap.
     let expected = Mat3::from_diagonal(Vec3::new(0.2, 0.1, 0.25));
-    assert!(mat_close(diag.inertia_local(), expected, 1e-6), "{}", diag.inertia_local());
+    assert!(
+        mat_close(diag.inertia_local(), expected, 1e-6),
+        "{}",
+        diag.inertia_local()
+    );
     let full = world.body(m.body("full").unwrap()).unwrap();
     let expected = Mat3::from_cols(
         Vec3::new(0.3, 0.01, 0.02),
@@ -189,7 +215,11 @@ fn cartpole_joints_keep_the_files_names_limits_and_coordinates() {
     }
     // Coordinates are zero at the file's placement, and follow MuJoCo's signs: the
     // cart moved +0.3 along x reads +0.3; the pole turned +0.1 about y reads +0.1.
-    let s = world.joint_position(slider.id.unwrap()).unwrap().scalar().unwrap();
+    let s = world
+        .joint_position(slider.id.unwrap())
+        .unwrap()
+        .scalar()
+        .unwrap();
     assert!(s.abs() < 1e-9);
     world
         .set_joint_position(slider.id.unwrap(), JointCoordinate::Scalar(0.3))
@@ -201,9 +231,15 @@ fn cartpole_joints_keep_the_files_names_limits_and_coordinates() {
         .unwrap();
     let lean = world.body(m.body("pole").unwrap()).unwrap().orientation() * Vec3::Z;
     let t2 = t + 0.1;
-    assert!((lean - Vec3::new(t2.sin(), 0.0, t2.cos())).length() < 1e-5, "{lean}");
+    assert!(
+        (lean - Vec3::new(t2.sin(), 0.0, t2.cos())).length() < 1e-5,
+        "{lean}"
+    );
     let a = &m.actuators[0];
-    assert_eq!((a.name.as_str(), a.kind.as_str(), a.joint.as_str()), ("push", "motor", "slider"));
+    assert_eq!(
+        (a.name.as_str(), a.kind.as_str(), a.joint.as_str()),
+        ("push", "motor", "slider")
+    );
     assert_eq!((a.gain, a.ctrl_range), (10.0, Some([-1.0, 1.0])));
 }
 
@@ -230,8 +266,15 @@ fn cartpole_keeps_its_centre_of_mass_over_the_rail() {
     let angle = world.joint_position(hinge).unwrap().scalar().unwrap();
     assert!(angle > 0.05, "the pole falls the way it leans: {angle}");
     // 1 mm of drift over 0.3 s while the pole's centre moves ~3 cm sideways.
-    eprintln!("cart-pole: centre of mass x moved {} m, pole at {angle} rad", com_x(&world) - x0);
-    assert!((com_x(&world) - x0).abs() < 1e-3, "{} vs {x0}", com_x(&world));
+    eprintln!(
+        "cart-pole: centre of mass x moved {} m, pole at {angle} rad",
+        com_x(&world) - x0
+    );
+    assert!(
+        (com_x(&world) - x0).abs() < 1e-3,
+        "{} vs {x0}",
+        com_x(&world)
+    );
 }
 
 /// A passive double pendulum released from horizontal: total energy stays within 0.1% of
@@ -267,8 +310,12 @@ fn pendulum_small_angle_period() {
             </worldbody></mujoco>"#
         );
         let mut world = z_up();
-        let m = mjcf::load(write("period.xml", &text), &mut world, &MjcfOptions::default())
-            .unwrap();
+        let m = mjcf::load(
+            write("period.xml", &text),
+            &mut world,
+            &MjcfOptions::default(),
+        )
+        .unwrap();
         let id = m.joint("pivot").unwrap().id.unwrap();
         let theta0 = 0.05;
         world
@@ -295,7 +342,10 @@ fn pendulum_small_angle_period() {
         eprintln!("pendulum l {l}: period {measured} s, closed form {period} s");
         // Measured within 1e-8 of it (f64); 1e-4 leaves room for f32's rounding over
         // thousands of steps, and still fails on a wrong mass, inertia or pivot.
-        assert!(close(measured, period, 1e-4), "l {l}: {measured} vs {period}");
+        assert!(
+            close(measured, period, 1e-4),
+            "l {l}: {measured} vs {period}"
+        );
     }
 }
 
@@ -312,12 +362,23 @@ fn collision_filters_follow_mujocos_rule() {
     }
     text += "</worldbody></mujoco>";
     let mut world = z_up();
-    let m = mjcf::load(write("filters.xml", &text), &mut world, &MjcfOptions::default()).unwrap();
+    let m = mjcf::load(
+        write("filters.xml", &text),
+        &mut world,
+        &MjcfOptions::default(),
+    )
+    .unwrap();
     for (i, a) in pairs.iter().enumerate() {
         for (j, b) in pairs.iter().enumerate() {
             let mujoco = a.0 & b.1 != 0 || b.0 & a.1 != 0;
-            let fa = world.body(m.body(&format!("b{i}")).unwrap()).unwrap().collision_filter();
-            let fb = world.body(m.body(&format!("b{j}")).unwrap()).unwrap().collision_filter();
+            let fa = world
+                .body(m.body(&format!("b{i}")).unwrap())
+                .unwrap()
+                .collision_filter();
+            let fb = world
+                .body(m.body(&format!("b{j}")).unwrap())
+                .unwrap()
+                .collision_filter();
             let tumble = fa.0 & fb.1 != 0 && fb.0 & fa.1 != 0;
             assert_eq!(mujoco, tumble, "{a:?} with {b:?}");
         }
@@ -338,12 +399,22 @@ fn several_joints_in_one_body_chain_and_keep_their_coordinates() {
         </body>
       </body></worldbody></mujoco>"#;
     let mut world = z_up();
-    let m = mjcf::load(write("chain.xml", text), &mut world, &MjcfOptions::default()).unwrap();
+    let m = mjcf::load(
+        write("chain.xml", text),
+        &mut world,
+        &MjcfOptions::default(),
+    )
+    .unwrap();
     // base, tip and two light bodies between them.
     assert_eq!(world.body_count(), 4);
-    assert!(m.warnings.iter().any(|w| w.message.contains("several joints")));
+    assert!(m
+        .warnings
+        .iter()
+        .any(|w| w.message.contains("several joints")));
     let tz = m.joint("tz").unwrap().id.unwrap();
-    world.set_joint_position(tz, JointCoordinate::Scalar(0.25)).unwrap();
+    world
+        .set_joint_position(tz, JointCoordinate::Scalar(0.25))
+        .unwrap();
     let tip = world.body(m.body("tip").unwrap()).unwrap().position();
     assert!((tip - Vec3::new(0.0, 0.0, 1.25)).length() < 1e-6, "{tip}");
     for _ in 0..100 {
@@ -374,9 +445,20 @@ fn unsupported_parts_are_warned_once_with_their_line() {
     let mut world = z_up();
     let m = mjcf::load(write("warn.xml", text), &mut world, &MjcfOptions::default()).unwrap();
     let lines: Vec<String> = m.warnings.iter().map(|w| w.to_string()).collect();
-    assert!(lines.contains(&"warn.xml:5: <geom>: mesh geoms: not yet read (skipped)".to_string()), "{lines:?}");
-    assert!(lines.iter().any(|l| l.starts_with("warn.xml:3: <joint>: joint armature")), "{lines:?}");
-    assert!(lines.contains(&"warn.xml:9: <tendon>: <tendon>: not read".to_string()), "{lines:?}");
+    assert!(
+        lines.contains(&"warn.xml:5: <geom>: mesh geoms: not yet read (skipped)".to_string()),
+        "{lines:?}"
+    );
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("warn.xml:3: <joint>: joint armature")),
+        "{lines:?}"
+    );
+    assert!(
+        lines.contains(&"warn.xml:9: <tendon>: <tendon>: not read".to_string()),
+        "{lines:?}"
+    );
     assert_eq!(lines.len(), 3, "{lines:?}");
 }
 
@@ -424,13 +506,21 @@ fn bad_files_give_one_line_naming_file_line_and_element() {
 #[test]
 fn missing_files_are_named() {
     let mut world = z_up();
-    let err = mjcf::load(model("no_such_model.xml"), &mut world, &MjcfOptions::default())
-        .unwrap_err()
-        .to_string();
+    let err = mjcf::load(
+        model("no_such_model.xml"),
+        &mut world,
+        &MjcfOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(err.starts_with("no_such_model.xml: cannot read"), "{err}");
-    let err = mjcf::load(model("bad_include_main.xml"), &mut world, &MjcfOptions::default())
-        .unwrap_err()
-        .to_string();
+    let err = mjcf::load(
+        model("bad_include_main.xml"),
+        &mut world,
+        &MjcfOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(
         err.starts_with("bad_include_main.xml:2: <include>: file: cannot read"),
         "{err}"
@@ -447,10 +537,17 @@ fn a_failure_while_creating_leaves_the_world_as_it_was() {
       <body name="twin"><joint/><geom size="0.1"/></body>
     </worldbody></mujoco>"#;
     let mut world = z_up();
-    let err = mjcf::load(write("twins.xml", text), &mut world, &MjcfOptions::default())
-        .unwrap_err()
-        .to_string();
-    assert!(err.starts_with("twins.xml:3: <body name=\"twin\">"), "{err}");
+    let err = mjcf::load(
+        write("twins.xml", text),
+        &mut world,
+        &MjcfOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.starts_with("twins.xml:3: <body name=\"twin\">"),
+        "{err}"
+    );
     assert_eq!(world.body_count(), 0);
     assert_eq!(world.joints().count(), 0);
 }

@@ -241,8 +241,18 @@ fn read_flags(flag: &Elem, s: &mut Settings, warn: &mut Warnings) {
 /// Sections with no physics the import reads, or none at all.
 fn warn_unread_sections(root: &Elem, warn: &mut Warnings) {
     const QUIET: [&str; 12] = [
-        "compiler", "option", "default", "worldbody", "actuator", "contact", "asset",
-        "visual", "statistic", "size", "keyframe", "extension",
+        "compiler",
+        "option",
+        "default",
+        "worldbody",
+        "actuator",
+        "contact",
+        "asset",
+        "visual",
+        "statistic",
+        "size",
+        "keyframe",
+        "extension",
     ];
     for kid in &root.children {
         if !QUIET.contains(&kid.tag.as_str()) {
@@ -258,7 +268,10 @@ fn warn_unread_sections(root: &Elem, warn: &mut Warnings) {
 
 /// Composes a child frame onto a parent's.
 fn compose(parent: (Vec3, Quat), child: (Vec3, Quat)) -> (Vec3, Quat) {
-    (parent.0 + parent.1 * child.0, (parent.1 * child.1).normalize())
+    (
+        parent.0 + parent.1 * child.0,
+        (parent.1 * child.1).normalize(),
+    )
 }
 
 /// The geoms, joints and child bodies of `elem` (a `<body>` or the `<worldbody>`), whose
@@ -350,7 +363,10 @@ fn child_body(
     let pose = compose(parent_pose, frame::frame(&v, &ctx.compiler)?);
     let child_class = match elem.own("childclass") {
         Some(c) if !defaults.has(c) => {
-            return Err(v.err("childclass", format!("no <default class=\"{}\">", printable(c))))
+            return Err(v.err(
+                "childclass",
+                format!("no <default class=\"{}\">", printable(c)),
+            ))
         }
         Some(c) => c,
         None => class,
@@ -373,12 +389,7 @@ fn child_body(
     body_contents(ctx, elem, target, pose, child_class)
 }
 
-fn new_body(
-    ctx: &mut Ctx<'_>,
-    elem: &Elem,
-    pose: (Vec3, Quat),
-    light_of: Option<usize>,
-) -> usize {
+fn new_body(ctx: &mut Ctx<'_>, elem: &Elem, pose: (Vec3, Quat), light_of: Option<usize>) -> usize {
     let name = match light_of {
         None => elem.own("name").map(str::to_string),
         Some(_) => None,
@@ -466,7 +477,10 @@ fn joint(ctx: &mut Ctx<'_>, v: &View<'_>, body: usize, other: usize) -> Result<P
         t => {
             return Err(v.err(
                 "type",
-                format!("unknown joint type '{}' (expected hinge, slide, ball, free)", printable(t)),
+                format!(
+                    "unknown joint type '{}' (expected hinge, slide, ball, free)",
+                    printable(t)
+                ),
             ))
         }
     };
@@ -487,17 +501,34 @@ fn joint(ctx: &mut Ctx<'_>, v: &View<'_>, body: usize, other: usize) -> Result<P
     let springref = unit(v.real("springref")?.unwrap_or(0.0));
     for key in ["armature", "frictionloss"] {
         if non_negative(v, key)? > 0.0 {
-            ctx.warn.add(v.elem, &format!("joint {key}: cannot be expressed, not applied"));
+            ctx.warn.add(
+                v.elem,
+                &format!("joint {key}: cannot be expressed, not applied"),
+            );
         }
     }
     let def = match kind.as_str() {
-        "hinge" => JointKind::Hinge { limits: range, motor: None, spring: None, servo: None },
-        "slide" => JointKind::Slider { limits: range, motor: None, spring: None, servo: None },
+        "hinge" => JointKind::Hinge {
+            limits: range,
+            motor: None,
+            spring: None,
+            servo: None,
+        },
+        "slide" => JointKind::Slider {
+            limits: range,
+            motor: None,
+            spring: None,
+            servo: None,
+        },
         _ => {
             if stiffness > 0.0 || damping > 0.0 {
-                ctx.warn.add(v.elem, "ball joint stiffness and damping: not applied");
+                ctx.warn
+                    .add(v.elem, "ball joint stiffness and damping: not applied");
             }
-            JointKind::Ball { cone: range.map(|r| r[1] + reference), twist: None }
+            JointKind::Ball {
+                cone: range.map(|r| r[1] + reference),
+                twist: None,
+            }
         }
     };
     Ok(PlanJoint {
@@ -525,7 +556,9 @@ fn non_negative(v: &View<'_>, key: &str) -> Result<Real> {
 /// `range` when the joint is limited (`limited`, or a range under `autolimits`).
 fn joint_range(v: &View<'_>, c: &Compiler) -> Result<Option<[Real; 2]>> {
     let range = v.reals("range", &[2])?;
-    let limited = v.flag("limited")?.unwrap_or(c.autolimits && range.is_some());
+    let limited = v
+        .flag("limited")?
+        .unwrap_or(c.autolimits && range.is_some());
     match (limited, range) {
         (false, _) => Ok(None),
         (true, None) => Err(v.err("range", "missing on a limited joint")),
@@ -539,11 +572,14 @@ fn exclusions(ctx: &mut Ctx<'_>, root: &Elem) -> Result<()> {
     for contact in root.kids("contact") {
         for kid in &contact.children {
             if kid.tag != "exclude" {
-                ctx.warn.add(kid, &format!("<contact><{}>: not read", kid.tag));
+                ctx.warn
+                    .add(kid, &format!("<contact><{}>: not read", kid.tag));
                 continue;
             }
             let find = |key: &str| -> Result<usize> {
-                let name = kid.own(key).ok_or_else(|| kid.err(format!("{key}: missing")))?;
+                let name = kid
+                    .own(key)
+                    .ok_or_else(|| kid.err(format!("{key}: missing")))?;
                 ctx.names
                     .iter()
                     .find(|(n, _)| n == name)
@@ -619,11 +655,15 @@ fn actuator(ctx: &mut Ctx<'_>, a: &Elem, index: usize) -> Result<Option<PlanActu
     }
     let range = |key: &str, limited: &str| -> Result<Option<[Real; 2]>> {
         let r = v.reals(key, &[2])?;
-        let on = v.flag(limited)?.unwrap_or(ctx.compiler.autolimits && r.is_some());
+        let on = v
+            .flag(limited)?
+            .unwrap_or(ctx.compiler.autolimits && r.is_some());
         Ok(if on { r.map(|r| [r[0], r[1]]) } else { None })
     };
     Ok(Some(PlanActuator {
-        name: a.own("name").map_or_else(|| format!("actuator{index}"), str::to_string),
+        name: a
+            .own("name")
+            .map_or_else(|| format!("actuator{index}"), str::to_string),
         kind: a.tag.clone(),
         joint,
         gain,

@@ -87,9 +87,7 @@ fn create_all(plan: &Plan, world: &mut World, made: &mut Made) -> Result<Ids> {
     pairs.dedup();
     if !pairs.is_empty() {
         world.set_contact_filter(move |p| {
-            pairs
-                .binary_search(&ordered(p.body_a, p.body_b))
-                .is_err()
+            pairs.binary_search(&ordered(p.body_a, p.body_b)).is_err()
         });
     }
     Ok(Ids { bodies, joints })
@@ -219,17 +217,32 @@ fn joint_def(
     _world: &World,
 ) -> Result<JointDef> {
     let b = &plan.bodies[j.body];
-    let body = ids[j.body].ok_or_else(|| SceneError::new(j.label.clone(), "joint on a static body"))?;
+    let body =
+        ids[j.body].ok_or_else(|| SceneError::new(j.label.clone(), "joint on a static body"))?;
     let anchor_w = b.position + b.orientation * j.anchor;
     let axis_w = b.orientation * j.axis;
     let (other, o_pos, o_rot) = match j.other.and_then(|o| ids[o].map(|id| (o, id))) {
-        Some((o, id)) => (Some(id), plan.bodies[o].position, plan.bodies[o].orientation),
+        Some((o, id)) => (
+            Some(id),
+            plan.bodies[o].position,
+            plan.bodies[o].orientation,
+        ),
         None => (None, Vec3::ZERO, Quat::IDENTITY),
     };
     let inv = o_rot.inverse();
     let kind = match j.def {
-        JointKind::Hinge { limits, .. } => JointKind::Hinge { limits, motor: None, spring: None, servo },
-        JointKind::Slider { limits, .. } => JointKind::Slider { limits, motor: None, spring: None, servo },
+        JointKind::Hinge { limits, .. } => JointKind::Hinge {
+            limits,
+            motor: None,
+            spring: None,
+            servo,
+        },
+        JointKind::Slider { limits, .. } => JointKind::Slider {
+            limits,
+            motor: None,
+            spring: None,
+            servo,
+        },
         other => other,
     };
     Ok(JointDef {

@@ -54,7 +54,10 @@ impl Compiler {
             Some(u) => {
                 return Err(v.err(
                     "angle",
-                    format!("unknown unit '{}' (expected degree or radian)", printable(u)),
+                    format!(
+                        "unknown unit '{}' (expected degree or radian)",
+                        printable(u)
+                    ),
                 ))
             }
         }

@@ -61,7 +61,11 @@ pub(crate) fn geom(v: &View<'_>, c: &Compiler, warn: &mut Warnings) -> Result<Op
         let half = 0.5 * (b - a).length();
         size = match kind {
             "capsule" | "cylinder" => vec![first(v, &size)?, half],
-            _ => vec![first(v, &size)?, size.get(1).copied().unwrap_or(size[0]), half],
+            _ => vec![
+                first(v, &size)?,
+                size.get(1).copied().unwrap_or(size[0]),
+                half,
+            ],
         };
     }
     let (shape, plane, unit) = shape_of(v, kind, &size)?;
@@ -136,12 +140,7 @@ fn shape_of(v: &View<'_>, kind: &str, size: &[Real]) -> Result<ShapeParts> {
             // MuJoCo's planes are infinite for collision (size only draws them).
             return Ok((None, Some(()), MassProperties::diagonal(0.0, Vec3::ZERO)));
         }
-        other => {
-            return Err(v.err(
-                "type",
-                format!("unknown geom type '{}'", printable(other)),
-            ))
-        }
+        other => return Err(v.err("type", format!("unknown geom type '{}'", printable(other)))),
     };
     Ok((Some(out.1), None, out.0))
 }
@@ -212,9 +211,7 @@ fn rgb(v: &View<'_>) -> Result<Option<[u8; 3]>> {
 /// `<inertial>`: mass, centre (`pos`), and the tensor from `diaginertia` (in the frame
 /// of `quat`/...) or `fullinertia` (ixx iyy izz ixy ixz iyz, body frame).
 pub(crate) fn inertial(v: &View<'_>, c: &Compiler) -> Result<MassProperties> {
-    let mass = v
-        .real("mass")?
-        .ok_or_else(|| v.err("mass", "missing"))?;
+    let mass = v.real("mass")?.ok_or_else(|| v.err("mass", "missing"))?;
     if mass < 0.0 {
         return Err(v.err("mass", format!("must be >= 0, got {mass}")));
     }

@@ -164,7 +164,11 @@ impl ImportedMjcf {
 }
 
 /// Adds the model in `path` to `world`. On an error the world is as it was.
-pub fn load(path: impl AsRef<Path>, world: &mut World, options: &MjcfOptions) -> Result<ImportedMjcf> {
+pub fn load(
+    path: impl AsRef<Path>,
+    world: &mut World,
+    options: &MjcfOptions,
+) -> Result<ImportedMjcf> {
     let root = parse::read(path.as_ref())?;
     build::build(&root, world, options)
 }

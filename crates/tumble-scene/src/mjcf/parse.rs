@@ -87,14 +87,12 @@ fn read_file(
     if stack.len() >= MAX_INCLUDE_DEPTH || stack.iter().any(|p| p == path) {
         return Err(fail(format!("'{shown}' includes itself")));
     }
-    let text = std::fs::read_to_string(path).map_err(|e| fail(format!("cannot read '{shown}': {e}")))?;
+    let text =
+        std::fs::read_to_string(path).map_err(|e| fail(format!("cannot read '{shown}': {e}")))?;
     let file: Rc<str> = display_name(path).into();
     let doc = roxmltree::Document::parse(&text).map_err(|e| {
         let pos = e.pos();
-        SceneError::new(
-            format!("{file}:{}", pos.row),
-            format!("malformed XML: {e}"),
-        )
+        SceneError::new(format!("{file}:{}", pos.row), format!("malformed XML: {e}"))
     })?;
     stack.push(path.to_path_buf());
     let root = convert(&doc, doc.root_element(), &file, base, stack);
@@ -266,9 +264,8 @@ impl<'a> View<'a> {
         let Some(text) = self.get(key) else {
             return Ok(None);
         };
-        let values = parse_reals(text).map_err(|bad| {
-            self.err(key, format!("'{}' is not a number", printable(bad)))
-        })?;
+        let values = parse_reals(text)
+            .map_err(|bad| self.err(key, format!("'{}' is not a number", printable(bad))))?;
         if !counts.contains(&values.len()) && !counts.is_empty() {
             let want: Vec<String> = counts.iter().map(|c| c.to_string()).collect();
             return Err(self.err(
