@@ -499,6 +499,11 @@ fn joint(ctx: &mut Ctx<'_>, v: &View<'_>, body: usize, other: usize) -> Result<P
     let stiffness = non_negative(v, "stiffness")? * passive;
     let damping = non_negative(v, "damping")? * passive;
     let springref = unit(v.real("springref")?.unwrap_or(0.0));
+    for key in ["solreflimit", "solimplimit", "margin"] {
+        if v.get(key).is_some() {
+            ctx.warn.add(v.elem, &format!("joint {key}: not read"));
+        }
+    }
     for key in ["armature", "frictionloss"] {
         if non_negative(v, key)? > 0.0 {
             ctx.warn.add(

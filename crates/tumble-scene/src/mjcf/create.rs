@@ -159,7 +159,9 @@ fn create_body(
     } else {
         let m = mass_of(plan, b);
         let (moments, _) = tumble::math::symmetric_eigen(m.inertia);
-        if !(m.mass > 0.0) || !(moments.min_element() > 0.0) {
+        // Written so that NaN fails too.
+        let positive = m.mass > 0.0 && moments.min_element() > 0.0;
+        if !positive {
             return Err(SceneError::new(
                 b.label.clone(),
                 format!(
@@ -316,6 +318,7 @@ fn imported(plan: Plan, ids: Ids, colors: Vec<(BodyId, Option<[u8; 3]>)>) -> Imp
                 id: Some(*id),
                 body: ids.bodies[j.body]?,
                 reference: j.reference,
+                spring: j.spring,
             })
         })
         .collect();
@@ -327,6 +330,7 @@ fn imported(plan: Plan, ids: Ids, colors: Vec<(BodyId, Option<[u8; 3]>)>) -> Imp
                 id: None,
                 body,
                 reference: 0.0,
+                spring: (0.0, 0.0, 0.0),
             });
         }
     }
@@ -339,8 +343,10 @@ fn imported(plan: Plan, ids: Ids, colors: Vec<(BodyId, Option<[u8; 3]>)>) -> Imp
             joint: plan.joints[a.joint].name.clone(),
             id: ids.joints[a.joint],
             gain: a.gain,
+            damping: a.damping,
             ctrl_range: a.ctrl_range,
             force_range: a.force_range,
+            control: 0.0,
         })
         .collect();
     let mut warnings: Vec<Warning> = plan.warnings;

@@ -32,6 +32,19 @@ pub(crate) struct Geom {
     pub rgb: Option<[u8; 3]>,
 }
 
+/// Geom attributes with physics the import does not map (contact softness, margins,
+/// fluid forces), warned about when a geom or its class sets them.
+const UNREAD: [&str; 8] = [
+    "condim",
+    "solref",
+    "solimp",
+    "solmix",
+    "margin",
+    "gap",
+    "priority",
+    "fluidshape",
+];
+
 /// Tumble's round shapes run along y, MuJoCo's along z: the turn taking y to z.
 fn y_to_z() -> Quat {
     Quat::from_axis_angle(Vec3::X, std::f64::consts::FRAC_PI_2 as Real)
@@ -43,6 +56,11 @@ pub(crate) fn geom(v: &View<'_>, c: &Compiler, warn: &mut Warnings) -> Result<Op
     if matches!(kind, "mesh" | "hfield" | "sdf") {
         warn.add(v.elem, &format!("{kind} geoms: not yet read (skipped)"));
         return Ok(None);
+    }
+    for key in UNREAD {
+        if v.get(key).is_some() {
+            warn.add(v.elem, &format!("geom {key}: not read"));
+        }
     }
     let size = v.reals("size", &[])?.unwrap_or_default();
     let (mut position, mut orientation) = frame::frame(v, c)?;

@@ -31,6 +31,7 @@
 //! Anything not read is reported once as a [`Warning`] naming the element and its line.
 
 mod build;
+mod control;
 mod create;
 mod frame;
 mod geom;
@@ -78,6 +79,9 @@ pub struct MjcfJoint {
     pub body: BodyId,
     /// MuJoCo's qpos at the file's placement (`ref`, rad or m): qpos = coordinate + ref.
     pub reference: Real,
+    /// The passive spring and damper: stiffness k, its rest coordinate (`springref −
+    /// ref`), damping c.
+    pub spring: (Real, Real, Real),
 }
 
 /// What an actuator drives and how.
@@ -93,10 +97,14 @@ pub struct MjcfActuator {
     pub id: JointId,
     /// gear (motor), kp (position) or kv (velocity).
     pub gain: Real,
+    /// A position actuator's `kv` (its damping), 0 otherwise.
+    pub damping: Real,
     /// `ctrlrange` when the control is limited.
     pub ctrl_range: Option<[Real; 2]>,
     /// `forcerange` when the force is limited.
     pub force_range: Option<[Real; 2]>,
+    /// The control last set (MuJoCo's `ctrl`), 0 at load; see [`ImportedMjcf::set_control`].
+    pub control: Real,
 }
 
 /// Something in the file the import did not read, with where it is.
