@@ -432,6 +432,42 @@ fn several_joints_in_one_body_chain_and_keep_their_coordinates() {
     }
 }
 
+/// `<frame>` places what it holds: a box 1 m up a frame turned 90° about z, in a body.
+#[test]
+fn frames_place_their_geoms_and_bodies() {
+    let text = r#"<mujoco><compiler angle="degree"/><worldbody>
+      <body name="b" pos="0 0 1"><freejoint/>
+        <geom type="sphere" size="0.1" mass="1"/>
+        <frame pos="1 0 0" euler="0 0 90">
+          <geom type="box" pos="1 0 0" size="0.1 0.1 0.1" mass="3"/>
+          <body name="c" pos="0 1 0"><joint axis="1 0 0"/><geom size="0.1"/></body>
+        </frame>
+      </body></worldbody></mujoco>"#;
+    let mut world = z_up();
+    let m = mjcf::load(
+        write("frame.xml", text),
+        &mut world,
+        &MjcfOptions::default(),
+    )
+    .unwrap();
+    let b = world.body(m.body("b").unwrap()).unwrap();
+    // The box sits at (1, 1, 0) in b's frame: the centre of mass is 3/4 of the way there.
+    let com = Vec3::new(0.75, 0.75, 0.0);
+    assert!(
+        (b.local_center_of_mass() - com).length() < 1e-9,
+        "{}",
+        b.local_center_of_mass()
+    );
+    let c = world.body(m.body("c").unwrap()).unwrap();
+    // (0, 1, 0) in the turned frame is (−1, 0, 0): c's origin is at (0, 0, 1) in the world.
+    assert!(
+        (c.position() - Vec3::new(0.0, 0.0, 1.0)).length() < 1e-9,
+        "{}",
+        c.position()
+    );
+    assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+}
+
 #[test]
 fn includes_and_their_defaults_are_read() {
     let (world, m) = load("with_include.xml");

@@ -306,12 +306,41 @@ fn body_contents(
     for kid in &elem.children {
         match kid.tag.as_str() {
             "body" => child_body(ctx, kid, target, pose, class)?,
+            "frame" => frame_contents(ctx, kid, target, pose, class)?,
             "geom" | "joint" | "freejoint" | "inertial" => {}
             "site" | "camera" | "light" => {}
             other => ctx.warn.add(kid, &format!("<{other}>: not read")),
         }
     }
     Ok(())
+}
+
+/// `<frame>`: a pose (and `childclass`) for the geoms and bodies inside it, which belong
+/// to the body around it.
+fn frame_contents(
+    ctx: &mut Ctx<'_>,
+    elem: &Elem,
+    target: usize,
+    pose: (Vec3, Quat),
+    class: &str,
+) -> Result<()> {
+    let defaults = ctx.defaults;
+    let v = View::new(elem, class, defaults)?;
+    let pose = compose(pose, frame::frame(&v, &ctx.compiler)?);
+    let class = match elem.own("childclass") {
+        Some(c) if !defaults.has(c) => {
+            return Err(v.err(
+                "childclass",
+                format!("no <default class=\"{}\">", printable(c)),
+            ))
+        }
+        Some(c) => c,
+        None => class,
+    };
+    if elem.kids("joint").next().is_some() || elem.kids("freejoint").next().is_some() {
+        return Err(v.err("joint", "joints belong in a <body>, not a <frame>"));
+    }
+    body_contents(ctx, elem, target, pose, class)
 }
 
 /// Moves a geom read in its element's frame into the frame `rel` of the body it joins.
