@@ -528,19 +528,7 @@ fn joint(ctx: &mut Ctx<'_>, v: &View<'_>, body: usize, other: usize) -> Result<P
     let stiffness = non_negative(v, "stiffness")? * passive;
     let damping = non_negative(v, "damping")? * passive;
     let springref = unit(v.real("springref")?.unwrap_or(0.0));
-    for key in ["solreflimit", "solimplimit", "margin"] {
-        if v.get(key).is_some() {
-            ctx.warn.add(v.elem, &format!("joint {key}: not read"));
-        }
-    }
-    for key in ["armature", "frictionloss"] {
-        if non_negative(v, key)? > 0.0 {
-            ctx.warn.add(
-                v.elem,
-                &format!("joint {key}: cannot be expressed, not applied"),
-            );
-        }
-    }
+    warn_unread_joint(ctx, v)?;
     let def = match kind.as_str() {
         "hinge" => JointKind::Hinge {
             limits: range,
@@ -577,6 +565,24 @@ fn joint(ctx: &mut Ctx<'_>, v: &View<'_>, body: usize, other: usize) -> Result<P
         reference,
         spring: (stiffness, springref - reference, damping),
     })
+}
+
+/// Joint attributes with nothing to map to, warned about once each.
+fn warn_unread_joint(ctx: &mut Ctx<'_>, v: &View<'_>) -> Result<()> {
+    for key in ["solreflimit", "solimplimit", "margin"] {
+        if v.get(key).is_some() {
+            ctx.warn.add(v.elem, &format!("joint {key}: not read"));
+        }
+    }
+    for key in ["armature", "frictionloss"] {
+        if non_negative(v, key)? > 0.0 {
+            ctx.warn.add(
+                v.elem,
+                &format!("joint {key}: cannot be expressed, not applied"),
+            );
+        }
+    }
+    Ok(())
 }
 
 fn non_negative(v: &View<'_>, key: &str) -> Result<Real> {
