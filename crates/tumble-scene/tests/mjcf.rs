@@ -674,3 +674,28 @@ fn actuator_controls_drive_their_joints() {
         .to_string();
     assert_eq!(err, "actuator 'nope': no such actuator");
 }
+
+/// A ball joint's coordinate is a rotation vector in the parent's frame: MuJoCo's qpos
+/// quaternion Q (in the child's placement frame q0) is the vector q0 · log(Q).
+#[test]
+fn ball_coordinates_map_to_mujocos_quaternion() {
+    let text = r#"<mujoco><compiler angle="degree"/><worldbody>
+      <body name="ball" pos="0 0 1" axisangle="0 0 1 90"><joint name="b" type="ball"/>
+        <geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.05"/></body>
+      </worldbody></mujoco>"#;
+    let mut world = z_up();
+    let m = mjcf::load(write("ball.xml", text), &mut world, &MjcfOptions::default()).unwrap();
+    let q0 = Quat::from_axis_angle(Vec3::Z, PI / 2.0);
+    // MuJoCo's qpos: 0.3 rad about the child's own x axis.
+    let local = Vec3::new(0.3, 0.0, 0.0);
+    let id = m.joint("b").unwrap().id.unwrap();
+    world
+        .set_joint_position(id, JointCoordinate::Vector(q0 * local))
+        .unwrap();
+    let q = world.body(m.body("ball").unwrap()).unwrap().orientation();
+    let mujoco = q0 * Quat::from_axis_angle(Vec3::X, 0.3);
+    assert!(q.dot(mujoco).abs() > 1.0 - 1e-6, "{q} vs {mujoco}");
+    // And the anchor stays put: the body turned about its origin.
+    let p = world.body(m.body("ball").unwrap()).unwrap().position();
+    assert!((p - Vec3::new(0.0, 0.0, 1.0)).length() < 1e-6, "{p}");
+}

@@ -26,7 +26,8 @@
 //!   gains to it; motors at zero control exert nothing; `armature` and `frictionloss`
 //!   cannot be expressed and are warned about;
 //! - contype/conaffinity → collision group/mask (exact, see `build::filters`); parent and
-//!   child never collide; `<contact><exclude>` pairs are filtered out.
+//!   child never collide; `<contact><exclude>` pairs are filtered out (the world's contact
+//!   filter, set when there are such pairs, replaces any filter set before).
 //!
 //! Anything not read is reported once as a [`Warning`] naming the element and its line.
 
