@@ -15,6 +15,7 @@ mod character;
 mod convert;
 mod joint_control;
 mod joints;
+mod mjcf;
 mod query;
 mod shapes;
 mod sim;

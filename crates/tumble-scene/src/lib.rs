@@ -18,6 +18,7 @@ mod character;
 mod error;
 mod force;
 mod joint;
+pub mod mjcf;
 mod plan;
 mod reader;
 mod save;
@@ -161,6 +162,8 @@ pub fn load_file(path: impl AsRef<Path>) -> Result<Scene> {
 pub fn load(name_or_path: &str) -> Result<Scene> {
     match builtin(name_or_path) {
         Some(json) => load_str(json),
+        // MJCF models (MuJoCo XML) by extension; see `mjcf`.
+        None if mjcf::is_mjcf(name_or_path) => mjcf::load_scene(name_or_path).map(|(s, _)| s),
         None if Path::new(name_or_path).exists() => load_file(name_or_path),
         None => Err(SceneError::new(
             ROOT,

@@ -482,6 +482,10 @@ class World:
     @staticmethod
     def from_json(text: str) -> World:
         """Loads a scene from JSON text."""
+    @staticmethod
+    def from_mjcf(path: Union[str, PathLike[str]]) -> World:
+        """Loads an MJCF (MuJoCo XML) model: names, joints and gravity from the file;
+        what is not read comes out as UserWarnings naming file, line and element."""
     def add_body(
         self,
         shape: Shape,
