@@ -18,9 +18,12 @@ mod character;
 mod error;
 mod force;
 mod joint;
+pub mod mesh_file;
+mod models;
 mod plan;
 mod reader;
 mod shape;
+pub mod urdf;
 
 use std::fmt;
 use std::path::Path;
@@ -43,7 +46,7 @@ pub use body::check_name;
 
 use reader::{Node, Obj};
 
-const TOP_KEYS: [&str; 24] = [
+const TOP_KEYS: [&str; 25] = [
     "name",
     "description",
     "gravity",
@@ -68,6 +71,7 @@ const TOP_KEYS: [&str; 24] = [
     "max_contacts_per_body",
     "max_push_speed",
     "character",
+    "models",
 ];
 
 /// The most `substeps` and `iterations` a scene or the command line may ask for.
@@ -98,6 +102,9 @@ pub struct Scene {
     /// The scene's `character`, walked along its path by [`Scene::step`]; its body is the
     /// last of the world's.
     pub character: Option<Walker>,
+    /// What a model file held that was read but not built as written, one line each
+    /// (see [`urdf::Imported::warnings`]); the CLI prints them.
+    pub warnings: Vec<String>,
 }
 
 impl Scene {
@@ -132,15 +139,45 @@ impl fmt::Debug for Scene {
     }
 }
 
-/// Reads a scene from JSON text.
+/// Reads a scene from JSON text. Model files its `models` name are found from the
+/// current directory.
 pub fn load_str(json: &str) -> Result<Scene> {
-    let value: Value = serde_json::from_str(json).map_err(json_error)?;
-    build(&Node::root(&value))
+    load_str_in(json, Path::new(""))
 }
 
-/// Reads a scene file.
+/// Reads a scene from JSON text whose `models` files are relative to `dir`.
+pub fn load_str_in(json: &str, dir: &Path) -> Result<Scene> {
+    let value: Value = serde_json::from_str(json).map_err(json_error)?;
+    build(&Node::root(&value), dir)
+}
+
+/// The kinds of file [`load_file`] reads, told apart by extension (any case): `urdf` a
+/// URDF model (see [`urdf::scene`]); anything else a JSON scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FileKind {
+    /// A JSON scene (docs/scene-format.md).
+    Scene,
+    /// A URDF model.
+    Urdf,
+}
+
+impl FileKind {
+    /// The kind of `path`, by its extension.
+    pub fn of(path: &Path) -> FileKind {
+        let ext = path.extension().and_then(|e| e.to_str());
+        match ext.map(str::to_ascii_lowercase).as_deref() {
+            Some("urdf") => FileKind::Urdf,
+            _ => FileKind::Scene,
+        }
+    }
+}
+
+/// Reads a scene file, or a model file run as a scene (by extension, see [`FileKind`]).
 pub fn load_file(path: impl AsRef<Path>) -> Result<Scene> {
     let path = path.as_ref();
+    if FileKind::of(path) == FileKind::Urdf {
+        return urdf::scene(path, &urdf::UrdfOptions::default());
+    }
     let text = std::fs::read_to_string(path).map_err(|e| {
         SceneError::new(
             ROOT,
@@ -150,7 +187,7 @@ pub fn load_file(path: impl AsRef<Path>) -> Result<Scene> {
             ),
         )
     })?;
-    load_str(&text)
+    load_str_in(&text, path.parent().unwrap_or(Path::new("")))
 }
 
 /// Reads a built-in scene by name, or else a file by path. Built-in names win, so a file
@@ -185,7 +222,7 @@ fn json_error(e: serde_json::Error) -> SceneError {
     )
 }
 
-fn build(root: &Node<'_>) -> Result<Scene> {
+fn build(root: &Node<'_>, dir: &Path) -> Result<Scene> {
     let obj = root.object()?;
     obj.only(&TOP_KEYS)?;
     let name = obj.str("name")?.map(str::to_string);
@@ -209,6 +246,8 @@ fn build(root: &Node<'_>) -> Result<Scene> {
     plan::check_settings(duration, dt)?;
     let mut world = World::try_new(&def).map_err(|e| SceneError::from_engine(e, ""))?;
     let (mut body_names, mut body_colors) = add_bodies(&obj, &mut world)?;
+    let warnings = models::add_models(&obj, dir, &mut world, &mut body_names)?;
+    body_colors.resize(body_names.len(), None);
     add_forces(&obj, &mut world)?;
     add_joints(&obj, &mut world)?;
     let character = match obj.get("character") {
@@ -229,6 +268,7 @@ fn build(root: &Node<'_>) -> Result<Scene> {
         body_names,
         body_colors,
         character,
+        warnings,
     })
 }
 
