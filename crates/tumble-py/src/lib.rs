@@ -15,6 +15,7 @@ mod character;
 mod convert;
 mod joint_control;
 mod joints;
+mod models;
 mod query;
 mod shapes;
 mod sim;
@@ -50,5 +51,6 @@ fn tumble_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     joints::register(m)?;
     character::register(m)?;
     callbacks::register(m)?;
+    models::register(m)?;
     Ok(())
 }

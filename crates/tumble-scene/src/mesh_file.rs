@@ -91,10 +91,8 @@ pub fn read_obj(name: &str, text: &str) -> Result<MeshData> {
                 for word in &words[1..] {
                     face.push(obj_index(name, line, word, mesh.vertices.len())?);
                 }
-                if face.len() < 3 {
-                    return Err(line_err(name, line, "f: a face needs at least 3 vertices"));
-                }
-                for k in 1..face.len() - 1 {
+                // A face of fewer than 3 vertices encloses nothing: skipped.
+                for k in 1..face.len().saturating_sub(1) {
                     mesh.triangles.push([face[0], face[k], face[k + 1]]);
                 }
                 if mesh.triangles.len() > MAX_TRIANGLES {

@@ -24,9 +24,10 @@ use super::UrdfOptions;
 use crate::error::{printable, Result, SceneError};
 use crate::mesh_file::{read_mesh, MeshData};
 
-/// The largest torque (force) a joint's damper may exert: unlimited in practice, so that
-/// it is URDF's pure viscous damping, τ = −c q̇.
-const UNLIMITED: Real = 1e30;
+/// The largest torque (force) a joint's damper may exert: unlimited in practice (the
+/// engine's largest, `limits::MAX_MAGNITUDE`), so that it is URDF's pure viscous damping,
+/// τ = −c q̇.
+const UNLIMITED: Real = tumble::limits::MAX_MAGNITUDE;
 
 /// Radius (m) of the placeholder sphere given to a link with no collision geometry (it
 /// collides with nothing and its mass properties are the file's).
@@ -167,14 +168,22 @@ pub(crate) fn plan(model: &Model, opts: &UrdfOptions) -> Result<Plan> {
     }
     let mut meshes = MeshCache::default();
     let mut bodies = Vec::with_capacity(groups.len());
+    let mut warnings = model.warnings.clone();
     for group in &groups {
-        let is_static = opts.fixed_base && group[0] == tree.order[0];
-        let mut planned = body(model, group, &offset, is_static, &mut meshes, opts)?;
+        let is_root = group[0] == tree.order[0];
+        let mut planned = body(
+            model,
+            group,
+            &offset,
+            is_root,
+            &mut meshes,
+            opts,
+            &mut warnings,
+        )?;
         planned.def.position = pose[group[0]].position;
         planned.def.orientation = pose[group[0]].rotation;
         bodies.push(planned);
     }
-    let mut warnings = Vec::new();
     let mut joints = Vec::new();
     for &l in &tree.order[1..] {
         let j = tree.parent_joint[l].expect("every link below the root has a parent joint");
@@ -269,28 +278,44 @@ impl MeshCache {
 }
 
 /// One body: the links of `group` (the first gives the frame), their masses summed about
-/// the common centre (parallel axes), their collision geometry as one shape.
+/// the common centre (parallel axes), their collision geometry as one shape. The root
+/// group is static with a fixed base, or when it has no mass (PyBullet's convention).
 fn body(
     model: &Model,
     group: &[usize],
     offset: &[Pose],
-    is_static: bool,
+    is_root: bool,
     meshes: &mut MeshCache,
     opts: &UrdfOptions,
+    warnings: &mut Vec<String>,
 ) -> Result<PlannedBody> {
     let first = &model.links[group[0]];
-    let parts: Vec<MassProperties> = group
-        .iter()
-        .filter_map(|&l| {
-            let i = model.links[l].inertial.filter(|i| i.mass > 0.0)?;
-            let local = MassProperties {
-                mass: i.mass,
-                center: i.center,
-                inertia: i.inertia,
-            };
-            Some(local.transformed(offset[l].position, offset[l].rotation))
-        })
-        .collect();
+    let mut parts = Vec::new();
+    for &l in group {
+        let link = &model.links[l];
+        let Some(i) = link.inertial.filter(|i| i.mass > 0.0) else {
+            continue;
+        };
+        let inertia = match i.inertia {
+            Some(tensor) => tensor,
+            None => {
+                warnings.push(format!(
+                    "{}: inertial.inertia: all zero; taken from the collision geometry at uniform density, as PyBullet does",
+                    link.at
+                ));
+                let alone = vec![Pose::IDENTITY; model.links.len()];
+                let (shape, _) = shape(model, &[l], &alone, false, meshes)?;
+                shape.mass_properties(1.0).with_mass(i.mass).inertia
+            }
+        };
+        let local = MassProperties {
+            mass: i.mass,
+            center: i.center,
+            inertia,
+        };
+        parts.push(local.transformed(offset[l].position, offset[l].rotation));
+    }
+    let is_static = is_root && (opts.fixed_base || parts.is_empty());
     let (shape, has_geometry) = shape(model, group, offset, is_static, meshes)?;
     let mut def = BodyDef {
         name: Some(format!("{}{}", opts.prefix, first.name)),

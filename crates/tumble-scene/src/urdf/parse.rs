@@ -45,12 +45,15 @@ pub(crate) struct Link {
 }
 
 /// A link's `<inertial>`: mass (kg) and the tensor about the centre of mass, both in the
-/// link frame (the `<origin>`'s rotation already applied: R I Rᵀ).
+/// link frame (the `<origin>`'s rotation already applied: R I Rᵀ). `inertia` is `None`
+/// when the file gives a mass but an all-zero tensor (common in exported files, and
+/// ignored by PyBullet, which by default takes the tensor from the collision shapes):
+/// the builder then does the same and says so.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Inertial {
     pub center: Vec3,
     pub mass: Real,
-    pub inertia: Mat3,
+    pub inertia: Option<Mat3>,
 }
 
 /// One `<collision>`: its geometry placed in the link frame.
@@ -118,6 +121,8 @@ pub(crate) struct Model {
     pub name: String,
     pub links: Vec<Link>,
     pub joints: Vec<Joint>,
+    /// What was read but will not be built as written, one line each.
+    pub warnings: Vec<String>,
 }
 
 /// Where the text came from: the name errors use and the folder meshes resolve against.
@@ -128,14 +133,19 @@ pub(crate) struct Source<'a> {
 
 /// Parses URDF text.
 pub(crate) fn parse(text: &str, src: &Source<'_>) -> Result<Model> {
-    let doc = Document::parse(text).map_err(|e| {
+    let text = blank_declaration(text);
+    let doc = Document::parse(&text).map_err(|e| {
         let pos = e.pos();
         SceneError::new(
             format!("{}:{}", src.label, pos.row),
             format!("malformed XML: {e}"),
         )
     })?;
-    let cx = Cx { doc: &doc, src };
+    let cx = Cx {
+        doc: &doc,
+        src,
+        warnings: Default::default(),
+    };
     let robot = doc.root_element();
     if robot.tag_name().name() != "robot" {
         return Err(cx.err(robot, "", "the root element must be <robot>"));
@@ -144,6 +154,7 @@ pub(crate) fn parse(text: &str, src: &Source<'_>) -> Result<Model> {
         name: robot.attribute("name").unwrap_or("robot").to_string(),
         links: Vec::new(),
         joints: Vec::new(),
+        warnings: Vec::new(),
     };
     for node in robot.children().filter(Node::is_element) {
         match node.tag_name().name() {
@@ -155,12 +166,14 @@ pub(crate) fn parse(text: &str, src: &Source<'_>) -> Result<Model> {
     if model.links.is_empty() {
         return Err(cx.err(robot, "", "has no <link>"));
     }
+    model.warnings = cx.warnings.take();
     Ok(model)
 }
 
 struct Cx<'a, 'input> {
     doc: &'a Document<'input>,
     src: &'a Source<'a>,
+    warnings: std::cell::RefCell<Vec<String>>,
 }
 
 impl Cx<'_, '_> {
@@ -197,7 +210,11 @@ impl Cx<'_, '_> {
         let Some(text) = node.attribute(attr) else {
             return Ok(None);
         };
-        let words: Vec<&str> = text.split_whitespace().collect();
+        // Whitespace separates, as the format says; commas too, as PyBullet allows.
+        let words: Vec<&str> = text
+            .split(|c: char| c.is_whitespace() || c == ',')
+            .filter(|w| !w.is_empty())
+            .collect();
         let nums: Vec<Real> = words
             .iter()
             .filter_map(|w| w.parse::<Real>().ok().filter(|x| x.is_finite()))
@@ -288,6 +305,13 @@ impl Cx<'_, '_> {
         }
         let [xx, xy, xz, yy, yz, zz] = v;
         let local = Mat3::from_cols_array(&[xx, xy, xz, xy, yy, yz, xz, yz, zz]);
+        if v.iter().all(|&x| x == 0.0) {
+            return Ok(Inertial {
+                inertia: None,
+                ..zero_mass(origin)
+            }
+            .with_mass(mass));
+        }
         if mass > 0.0 {
             self.check_tensor(link, local)?;
         }
@@ -295,7 +319,7 @@ impl Cx<'_, '_> {
         Ok(Inertial {
             center: origin.position,
             mass,
-            inertia: r * local * r.transpose(),
+            inertia: Some(r * local * r.transpose()),
         })
     }
 
@@ -442,7 +466,8 @@ impl Cx<'_, '_> {
             None => None,
         }
         .unwrap_or(Vec3::X);
-        if axis.length() < 1e-9 {
+        let has_axis = !matches!(kind, JointType::Fixed | JointType::Floating);
+        if has_axis && axis.length() < 1e-9 {
             return Err(self.err(node, "axis.xyz", "must be a non-zero direction"));
         }
         let (damping, friction) = self.dynamics(node)?;
@@ -450,7 +475,7 @@ impl Cx<'_, '_> {
             at: self.at(node),
             limits: self.limits(node, kind)?,
             origin: self.origin(node, "")?,
-            axis: axis.normalize(),
+            axis: axis.try_normalize().unwrap_or(Vec3::X),
             name,
             kind,
             parent,
@@ -471,11 +496,12 @@ impl Cx<'_, '_> {
         let lower = self.real(l, "limit.lower", "lower")?.unwrap_or(0.0);
         let upper = self.real(l, "limit.upper", "upper")?.unwrap_or(0.0);
         if lower > upper {
-            return Err(self.err(
-                node,
-                "limit",
-                format!("lower ({lower}) must be <= upper ({upper})"),
+            // PyBullet's convention (Bullet's): lower above upper means no limits.
+            self.warnings.borrow_mut().push(format!(
+                "{}: limit: lower ({lower}) > upper ({upper}), read as no limits (PyBullet's convention)",
+                self.at(node)
             ));
+            return Ok(None);
         }
         Ok(Some([lower, upper]))
     }
@@ -502,8 +528,32 @@ fn zero_mass(origin: Pose) -> Inertial {
     Inertial {
         center: origin.position,
         mass: 0.0,
-        inertia: Mat3::ZERO,
+        inertia: Some(Mat3::ZERO),
     }
+}
+
+impl Inertial {
+    fn with_mass(self, mass: Real) -> Inertial {
+        Inertial { mass, ..self }
+    }
+}
+
+/// The text with its `<?xml ...?>` declaration blanked out (newlines kept, so lines stay
+/// where they were): it says nothing a URDF reader needs, and files that put comments or
+/// blank lines before it (which XML forbids, and PyBullet reads) would otherwise fail.
+fn blank_declaration(text: &str) -> std::borrow::Cow<'_, str> {
+    let Some(start) = text.find("<?xml") else {
+        return text.into();
+    };
+    let Some(len) = text[start..].find("?>") else {
+        return text.into();
+    };
+    let end = start + len + 2;
+    let blank: String = text[start..end]
+        .chars()
+        .map(|c| if c == '\n' { '\n' } else { ' ' })
+        .collect();
+    format!("{}{blank}{}", &text[..start], &text[end..]).into()
 }
 
 /// The first element child of `node` called `tag`.
