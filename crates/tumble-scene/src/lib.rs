@@ -246,8 +246,7 @@ fn build(root: &Node<'_>, dir: &Path) -> Result<Scene> {
     plan::check_settings(duration, dt)?;
     let mut world = World::try_new(&def).map_err(|e| SceneError::from_engine(e, ""))?;
     let (mut body_names, mut body_colors) = add_bodies(&obj, &mut world)?;
-    let warnings = models::add_models(&obj, dir, &mut world, &mut body_names)?;
-    body_colors.resize(body_names.len(), None);
+    let warnings = models::add_models(&obj, dir, &mut world, &mut body_names, &mut body_colors)?;
     add_forces(&obj, &mut world)?;
     add_joints(&obj, &mut world)?;
     let character = match obj.get("character") {

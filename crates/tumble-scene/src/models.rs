@@ -22,13 +22,14 @@ const MODEL_KEYS: [&str; 6] = [
     "prefix",
 ];
 
-/// Adds every model of `obj`'s `models`, appending the bodies' labels to `names`;
-/// returns the models' warnings.
+/// Adds every model of `obj`'s `models`, appending the bodies' labels to `names` and
+/// colours to `colors`; returns the models' warnings.
 pub(crate) fn add_models(
     obj: &Obj<'_>,
     dir: &Path,
     world: &mut World,
     names: &mut Vec<String>,
+    colors: &mut Vec<Option<[u8; 3]>>,
 ) -> Result<Vec<String>> {
     let Some(models) = obj.get("models") else {
         return Ok(Vec::new());
@@ -56,6 +57,7 @@ pub(crate) fn add_models(
             let body = world.body(*id).expect("just created");
             names.push(body.name().unwrap_or_default().to_string());
         }
+        colors.extend(imported.colors);
         warnings.extend(imported.warnings);
     }
     Ok(warnings)

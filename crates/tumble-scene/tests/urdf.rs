@@ -672,3 +672,162 @@ fn bad_files_are_refused_with_file_line_and_element_and_change_nothing() {
     );
     assert_eq!((w.body_count(), w.joints().count()), (4, 2));
 }
+
+#[test]
+fn a_scene_places_models_whose_links_its_joints_can_name() {
+    // Two copies of one file, the second prefixed and free; a ball of the scene's own
+    // welded to the first copy's lower rod by name. File paths are the scene file's.
+    let d = dir("models");
+    write(&d, "double.urdf", &double_pendulum(1.0, 1.0, 1.0, 1.0));
+    let scene = r#"{"gravity": [0, 0, -9.81],
+      "bodies": [{"name": "ball", "shape": {"type": "sphere", "radius": 0.1}, "mass": 1,
+                  "position": [0, 0, 0]}],
+      "models": [
+        {"file": "double.urdf", "position": [0, 0, 2]},
+        {"file": "double.urdf", "prefix": "b_", "position": [3, 0, 2],
+         "orientation": [0, 0, 1, 0], "fixed_base": false, "merge_fixed": true}],
+      "joints": [{"type": "fixed", "body": "ball", "other": "lower"}]}"#;
+    let path = write(&d, "scene.json", scene);
+    let s = tumble_scene::load(path.to_str().unwrap()).unwrap();
+    assert_eq!(
+        s.body_names,
+        ["ball", "base", "upper", "lower", "b_base", "b_upper", "b_lower"]
+    );
+    assert_eq!(s.body_colors.len(), 7);
+    let w = &s.world;
+    let upper = w.body(w.find_body("b_upper").unwrap()).unwrap();
+    assert!((upper.center_of_mass() - Vec3::new(3.0, 0.0, 1.5)).length() < EXACT);
+    assert!(w.find_joint("b_elbow").is_some() && w.find_joint("elbow").is_some());
+    assert_eq!(w.joints().count(), 5);
+
+    let bad = |models: &str| {
+        let path = write(&d, "bad.json", &format!(r#"{{"models": [{models}]}}"#));
+        tumble_scene::load(path.to_str().unwrap())
+            .unwrap_err()
+            .to_string()
+    };
+    assert_eq!(
+        bad(r#"{"file": "double.urdf", "colour": "red"}"#),
+        "models[0].colour: unknown key (expected one of: file, position, orientation, fixed_base, merge_fixed, prefix)"
+    );
+    assert_eq!(
+        bad(r#"{"file": "double.json"}"#),
+        "models[0].file: expected a model file ending in .urdf"
+    );
+    let missing = bad(r#"{"file": "gone.urdf"}"#);
+    assert!(
+        missing.starts_with("models[0]: ") && missing.contains("gone.urdf: cannot read"),
+        "{missing}"
+    );
+}
+
+/// One rod on a hinge about y with `<dynamics>`, released at `q0`.
+fn damped(damping: Real, friction: Real) -> String {
+    format!(
+        r#"<robot name="damped"><link name="base"/>{rod}
+  <joint name="j" type="continuous"><parent link="base"/><child link="rod"/><axis xyz="0 1 0"/>
+    <dynamics damping="{damping}" friction="{friction}"/></joint></robot>"#,
+        rod = rod("rod", 1.0, 1.0)
+    )
+}
+
+#[test]
+fn joint_damping_decays_the_swing_at_its_closed_form_rate_and_friction_holds() {
+    // Damping c (N·m·s/rad) on a pendulum of moment I about its pivot: small swings decay
+    // as q₀ e^(−γt), γ = c / 2I. The first peak of |q| after 4 s is compared with that
+    // envelope at the peak's time; 2 % allowed (the damped solution's peaks stand
+    // √(1 + (γ/ω)²) ≈ 1.0008 above the envelope; the rest is the step's O(h) error).
+    let d = dir("damping");
+    let c = 0.1;
+    let path = write(&d, "damped.urdf", &damped(c, 0.0));
+    let mut w = z_up();
+    let m = load(&path, &mut w, true);
+    let j = m.joint("j").unwrap();
+    assert!(
+        matches!(w.joint(j).unwrap().kind(), JointKind::Hinge { servo: Some(s), .. } if s.damping == c && s.stiffness == 0.0)
+    );
+    let q0 = 0.05;
+    w.set_joint_position(j, JointCoordinate::Scalar(q0))
+        .unwrap();
+    let i_pivot = (1.0 + 0.0025) / 12.0 + 0.25;
+    let dt = 1.0 / 480.0;
+    let (mut prev, mut rising, mut peak) = (q0, false, None);
+    for k in 1..(6.0 / dt) as usize {
+        w.step(dt).unwrap();
+        let q = angle(&w, j).abs();
+        let t = (k - 1) as Real * dt;
+        if rising && q < prev && t > 4.0 {
+            peak = Some((t, prev));
+            break;
+        }
+        rising = q > prev;
+        prev = q;
+    }
+    let (t, peak) = peak.expect("a peak after 4 s");
+    let envelope = q0 * (-c * t / (2.0 * i_pivot)).exp();
+    assert!(
+        (peak / envelope - 1.0).abs() < 0.02,
+        "peak {peak} at {t} s vs envelope {envelope}"
+    );
+    // Undamped, it would still be at q0: the damping did act.
+    assert!(peak < 0.6 * q0);
+
+    // Friction 1 N·m holds the rod at 0.1 rad, where gravity's torque is
+    // m g (l/2) sin 0.1 = 0.49 N·m; at 0.3 rad (1.45 N·m) it swings.
+    let path = write(&d, "stuck.urdf", &damped(0.0, 1.0));
+    for (q, moves) in [(0.1 as Real, false), (0.3, true)] {
+        let mut w = z_up();
+        let m = load(&path, &mut w, true);
+        let j = m.joint("j").unwrap();
+        w.set_joint_position(j, JointCoordinate::Scalar(q)).unwrap();
+        for _ in 0..120 {
+            w.step(1.0 / 120.0).unwrap();
+        }
+        let moved = (angle(&w, j) - q).abs();
+        assert_eq!(moved > 0.01, moves, "from {q} rad it moved {moved} rad");
+    }
+}
+
+#[test]
+fn what_is_read_but_not_built_as_written_is_warned_with_its_line() {
+    let d = dir("warnings");
+    let text = r#"<?xml version="1.0"?>
+<robot name="w">
+  <link name="base"/>
+  <link name="a"><inertial><mass value="2"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.1, 0.2, 0.3"/></geometry></collision></link>
+  <link name="b"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="slide" type="prismatic"><parent link="base"/><child link="a"/>
+    <limit lower="1" upper="-1"/></joint>
+  <joint name="flat" type="planar"><parent link="a"/><child link="b"/></joint>
+</robot>"#;
+    let path = write(&d, "w.urdf", text);
+    let mut w = z_up();
+    let m = load(&path, &mut w, true);
+    let warnings: Vec<String> = m
+        .warnings
+        .iter()
+        .map(|s| s.replace(&format!("{}/", d.display()), ""))
+        .collect();
+    assert_eq!(
+        warnings,
+        [
+            "w.urdf:7: <joint name=\"slide\">: limit: lower (1) > upper (-1), read as no limits (PyBullet's convention)",
+            "w.urdf:4: <link name=\"a\">: inertial.inertia: all zero; taken from the collision geometry at uniform density, as PyBullet does",
+            "w.urdf:9: <joint name=\"flat\">: type: planar joints are not supported; the child link moves freely",
+        ]
+    );
+    // The box's own tensor at 2 kg: m (b² + c²) / 12 and so on.
+    let a = w.body(m.body("a").unwrap()).unwrap();
+    let expect = Vec3::new(2.0 * 0.13 / 12.0, 2.0 * 0.10 / 12.0, 2.0 * 0.05 / 12.0);
+    assert!(
+        (a.principal_inertia().0 - expect).length() < 1e-9,
+        "{}",
+        a.principal_inertia().0
+    );
+    assert!(matches!(
+        w.joint(m.joint("slide").unwrap()).unwrap().kind(),
+        JointKind::Slider { limits: None, .. }
+    ));
+    assert!(m.joint("flat").is_none());
+}

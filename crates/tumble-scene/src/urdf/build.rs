@@ -35,6 +35,7 @@ const NO_SHAPE_RADIUS: Real = 0.01;
 
 pub(crate) struct PlannedBody {
     pub at: String,
+    pub color: Option<[u8; 3]>,
     pub def: BodyDef,
     pub shape: Shape,
 }
@@ -345,6 +346,7 @@ fn body(
     }
     Ok(PlannedBody {
         at: first.at.clone(),
+        color: first.color,
         def,
         shape,
     })

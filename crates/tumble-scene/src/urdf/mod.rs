@@ -69,6 +69,8 @@ pub struct Imported {
     pub joints: Vec<(String, JointId)>,
     /// The bodies created, in creation order (one per link, or per merged group).
     pub created: Vec<BodyId>,
+    /// Each created body's colour (its link's first visual material), for pictures.
+    pub colors: Vec<Option<[u8; 3]>>,
     /// What was read but not built as written (a planar joint), one line each.
     pub warnings: Vec<String>,
 }
@@ -123,6 +125,7 @@ pub fn load_str(
             .map(|(j, id)| (j.name[opts.prefix.len()..].to_string(), *id))
             .collect(),
         created,
+        colors: plan.bodies.iter().map(|b| b.color).collect(),
         warnings: plan.warnings,
     })
 }
@@ -153,7 +156,7 @@ pub fn scene(path: &Path, opts: &UrdfOptions) -> Result<Scene> {
         world,
         dt: DEFAULT_DT,
         duration: DEFAULT_DURATION,
-        body_colors: vec![None; imported.created.len()],
+        body_colors: imported.colors,
         body_names,
         character: None,
         warnings: imported.warnings,

@@ -42,6 +42,8 @@ pub(crate) struct Link {
     pub at: String,
     pub inertial: Option<Inertial>,
     pub collisions: Vec<Collision>,
+    /// The colour of its first visual's material (pictures only).
+    pub color: Option<[u8; 3]>,
 }
 
 /// A link's `<inertial>`: mass (kg) and the tensor about the centre of mass, both in the
@@ -156,9 +158,14 @@ pub(crate) fn parse(text: &str, src: &Source<'_>) -> Result<Model> {
         joints: Vec::new(),
         warnings: Vec::new(),
     };
+    let materials = materials(robot);
     for node in robot.children().filter(Node::is_element) {
         match node.tag_name().name() {
-            "link" => model.links.push(cx.link(node)?),
+            "link" => {
+                let mut link = cx.link(node)?;
+                link.color = color(node, &materials);
+                model.links.push(link);
+            }
             "joint" => model.joints.push(cx.joint(node)?),
             _ => {}
         }
@@ -279,6 +286,7 @@ impl Cx<'_, '_> {
             at: self.at(node),
             inertial,
             collisions,
+            color: None,
         })
     }
 
@@ -554,6 +562,40 @@ fn blank_declaration(text: &str) -> std::borrow::Cow<'_, str> {
         .map(|c| if c == '\n' { '\n' } else { ' ' })
         .collect();
     format!("{}{blank}{}", &text[..start], &text[end..]).into()
+}
+
+/// The robot's named materials' colours, `<material name><color rgba>`, in file order.
+fn materials<'a>(robot: Node<'a, '_>) -> Vec<(&'a str, [u8; 3])> {
+    robot
+        .children()
+        .filter(|m| m.has_tag_name("material"))
+        .filter_map(|m| Some((m.attribute("name")?, rgba(m)?)))
+        .collect()
+}
+
+/// A material's `<color rgba="r g b a">` (0 to 1 each) as bytes; badly formed colours are
+/// ignored, as everything visual is.
+fn rgba(material: Node<'_, '_>) -> Option<[u8; 3]> {
+    let text = child(material, "color")?.attribute("rgba")?;
+    let v: Vec<f64> = text
+        .split_whitespace()
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    let byte = |x: f64| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
+    match v[..] {
+        [r, g, b, ..] if v.iter().all(|x| x.is_finite()) => Some([byte(r), byte(g), byte(b)]),
+        _ => None,
+    }
+}
+
+/// The colour of a link's first visual's material: its own `<color>`, or the named
+/// material's.
+fn color(link: Node<'_, '_>, materials: &[(&str, [u8; 3])]) -> Option<[u8; 3]> {
+    let material = child(child(link, "visual")?, "material")?;
+    rgba(material).or_else(|| {
+        let name = material.attribute("name")?;
+        materials.iter().find(|(n, _)| *n == name).map(|(_, c)| *c)
+    })
 }
 
 /// The first element child of `node` called `tag`.
