@@ -63,6 +63,10 @@ def test_from_urdf_is_z_up_and_names_bodies_and_joints_as_the_file(pendulum):
     assert free.body("upper").kind == "dynamic"
     np.testing.assert_array_equal(free.gravity, [0.0, -9.8, 0.0])
     np.testing.assert_allclose(free.body("upper").position, [1, 2, 3], atol=1e-12)
+    # from_scene takes a model file too, by its extension (as `tumble run` does).
+    scene = tumble.World.from_scene(pendulum)
+    np.testing.assert_array_equal(scene.gravity, [0.0, 0.0, -9.81])
+    assert scene.joint("elbow").kind == "hinge"
 
 
 def test_joint_positions_are_the_files_coordinates_readable_and_settable(pendulum):

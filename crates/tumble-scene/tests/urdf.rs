@@ -641,9 +641,7 @@ fn bad_files_are_refused_with_file_line_and_element_and_change_nothing() {
     refused(
         &d,
         "flat.urdf",
-        &format!(
-            "<robot name=\"r\">\n<link name=\"base\"/><link name=\"a\">\n<inertial><mass value=\"1\"/><inertia ixx=\"1\" iyy=\"1\" izz=\"1\"/></inertial>\n<collision>\n<geometry><mesh filename=\"flat.obj\"/></geometry></collision>\n</link>\n<joint name=\"j\" type=\"continuous\"><parent link=\"base\"/><child link=\"a\"/></joint>\n</robot>\n"
-        ),
+        "<robot name=\"r\">\n<link name=\"base\"/><link name=\"a\">\n<inertial><mass value=\"1\"/><inertia ixx=\"1\" iyy=\"1\" izz=\"1\"/></inertial>\n<collision>\n<geometry><mesh filename=\"flat.obj\"/></geometry></collision>\n</link>\n<joint name=\"j\" type=\"continuous\"><parent link=\"base\"/><child link=\"a\"/></joint>\n</robot>\n",
         "flat.urdf:4: <collision>: geometry.mesh: 'flat.obj' has no volume to take a convex hull of (needs at least 4 points that are not all in one plane)",
     );
     // The engine's own refusal, met half way through creating: a second copy's second

@@ -425,9 +425,7 @@ impl Cx<'_, '_> {
             .attribute("filename")
             .ok_or_else(|| self.err(g, "filename", "is required"))?;
         let scale = match self.reals::<3>(g, "scale", "scale")? {
-            Some(s) if s.iter().any(|&x| x == 0.0) => {
-                return Err(self.err(g, "scale", "must not be 0"))
-            }
+            Some(s) if s.contains(&0.0) => return Err(self.err(g, "scale", "must not be 0")),
             Some(s) => Vec3::from_array(s),
             None => Vec3::ONE,
         };
