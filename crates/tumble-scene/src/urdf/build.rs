@@ -342,7 +342,10 @@ fn body(
         let total = MassProperties::sum(parts);
         def.mass = MassSpec::Mass(total.mass);
         def.center_of_mass = Some(total.center);
-        def.inertia = Some(InertiaSpec::Tensor(total.inertia));
+        // R I Rᵀ and the parallel-axis sums are symmetric only to rounding, which in f32
+        // can exceed the engine's symmetry check: the mean of the two halves is exact.
+        let i = total.inertia;
+        def.inertia = Some(InertiaSpec::Tensor((i + i.transpose()) * 0.5));
     }
     Ok(PlannedBody {
         at: first.at.clone(),
