@@ -16,9 +16,15 @@ use crate::world::{Inner, PyWorld};
 /// file's joint coordinate) and `warnings` (what was read but not built as written).
 #[pyclass(module = "tumble", name = "Model", frozen, get_all)]
 pub struct PyModel {
+    /// The file's model name (URDF's <robot name>).
     name: String,
+    /// Each link by its name in the file: its tumble.Body (links merged by fixed joints
+    /// share one).
     bodies: Py<PyDict>,
+    /// Each joint by its name in the file: its tumble.Joint, whose `position` is the
+    /// file's joint coordinate.
     joints: Py<PyDict>,
+    /// What was read but not built as written, one line each.
     warnings: Vec<String>,
 }
 
