@@ -840,3 +840,38 @@ fn what_is_read_but_not_built_as_written_is_warned_with_its_line() {
     ));
     assert!(m.joint("flat").is_none());
 }
+
+#[test]
+fn a_zero_pose_outside_the_limits_starts_at_the_nearer_limit() {
+    // URDF's zero pose need not lie within a joint's limits (a quadruped's knees); left
+    // there, the limit row would snap the joint 0.5 rad in one step (measured: 49 rad/s).
+    // Started at the limit instead, the rod only falls against it: released at 0.5 rad
+    // it swings towards 0 and rests on the limit, its rate never above what gravity
+    // gives in 0.2 s (m g c sin 0.5 / I · 0.2 ≈ 1.4 rad/s; 3 allowed).
+    let d = dir("startlimit");
+    let text = double_pendulum(1.0, 1.0, 1.0, 1.0).replace(
+        r#"<limit lower="-3" upper="3""#,
+        r#"<limit lower="0.5" upper="1.0""#,
+    );
+    let path = write(&d, "limited.urdf", &text);
+    let mut w = z_up();
+    let m = load(&path, &mut w, true);
+    let elbow = m.joint("elbow").unwrap();
+    assert!(
+        (angle(&w, elbow) - 0.5).abs() < 1e-6,
+        "starts at {}",
+        angle(&w, elbow)
+    );
+    assert_eq!(m.warnings.len(), 1);
+    assert!(m.warnings[0].ends_with(
+        "<joint name=\"elbow\">: limit: the file's zero pose is outside the limits; the joint starts at 0.5"
+    ));
+    let mut fastest: Real = 0.0;
+    for _ in 0..48 {
+        w.step(1.0 / 240.0).unwrap();
+        let rate = w.joint_velocity(elbow).unwrap().scalar().unwrap();
+        fastest = fastest.max(rate.abs());
+    }
+    assert!(fastest < 3.0, "the elbow moved at up to {fastest} rad/s");
+    assert!(angle(&w, elbow) > 0.5 - 0.01);
+}

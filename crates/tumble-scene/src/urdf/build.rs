@@ -15,8 +15,8 @@ use std::path::PathBuf;
 
 use tumble::shape::{CompoundChild, MassProperties, TriMesh};
 use tumble::{
-    BodyDef, BodyId, BodyKind, InertiaSpec, JointDef, JointId, JointKind, MassSpec, Motor, Quat,
-    Real, Servo, Shape, Vec3, World,
+    BodyDef, BodyId, BodyKind, InertiaSpec, JointCoordinate, JointDef, JointId, JointKind,
+    MassSpec, Motor, Quat, Real, Servo, Shape, Vec3, World,
 };
 
 use super::parse::{Geometry, JointType, Model, Pose};
@@ -49,6 +49,9 @@ pub(crate) struct PlannedJoint {
     pub other_anchor: Vec3,
     pub axis: Vec3,
     pub other_axis: Vec3,
+    /// Where the joint starts when the file's zero pose is outside its limits: the
+    /// nearer limit (a limit row would otherwise snap it there in one step).
+    pub start: Option<Real>,
 }
 
 pub(crate) struct Plan {
@@ -205,7 +208,18 @@ pub(crate) fn plan(model: &Model, opts: &UrdfOptions) -> Result<Plan> {
             _ => joint_kind(joint),
         };
         let parent_frame = offset[p].then(&joint.origin);
+        let start = joint
+            .limits
+            .filter(|[lo, hi]| *lo > 0.0 || *hi < 0.0)
+            .map(|[lo, hi]| if lo > 0.0 { lo } else { hi });
+        if let Some(q) = start {
+            warnings.push(format!(
+                "{}: limit: the file's zero pose is outside the limits; the joint starts at {q}",
+                joint.at
+            ));
+        }
         joints.push(PlannedJoint {
+            start,
             at: joint.at.clone(),
             name: format!("{}{}", opts.prefix, joint.name),
             kind,
@@ -483,6 +497,14 @@ fn create_all(
             .create_joint(&def)
             .map_err(|e| SceneError::from_engine(e, "").within_at(&j.at, ""))?;
         joints.push(id);
+    }
+    // Parents before children (the plan's order), each posing its child's side.
+    for (j, &id) in plan.joints.iter().zip(joints.iter()) {
+        if let Some(q) = j.start {
+            world
+                .set_joint_position(id, JointCoordinate::Scalar(q))
+                .map_err(|e| SceneError::from_engine(e, "").within_at(&j.at, "limit"))?;
+        }
     }
     Ok(())
 }
