@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Renders the README's gallery: docs/gallery/*.gif from the built-in scenes.
+# Renders the README's gallery: docs/gallery/*.gif from the built-in scenes and the
+# example URDF robot.
 # Usage: scripts/gallery.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,4 +12,5 @@ render free_fall      --out "$out/free_fall.gif"      --fps 20
 render dzhanibekov    --out "$out/dzhanibekov.gif"    --fps 15 --duration 8
 render pyramid        --out "$out/pyramid.gif"        --fps 12 --contacts
 render pendulum_chain --out "$out/pendulum_chain.gif" --fps 20 --joints
+render examples/robot/arm.urdf --out "$out/arm_urdf.gif" --fps 15 --duration 3
 ls -l "$out"

@@ -13,7 +13,8 @@ pub const CONTACTS_HEADER: &str = "body_a,body_b,x,y,z,nx,ny,nz,separation";
 /// Options of `tumble contacts`.
 #[derive(Args, Debug)]
 pub struct ContactsArgs {
-    /// Scene: a built-in name (see `tumble scenes`) or a JSON scene file.
+    /// Scene: a built-in name (see `tumble scenes`), a JSON scene file, or a URDF model
+    /// (`.urdf`: z-up gravity, base fixed).
     #[arg(value_name = "SCENE")]
     pub scene: String,
 }
@@ -23,7 +24,7 @@ pub struct ContactsArgs {
 /// the separation along it (m, negative when penetrating). Gaps narrower than the
 /// speculative margin are listed too, with positive separation.
 pub fn contacts(args: &ContactsArgs) -> Result<(), Failure> {
-    let mut scene = tumble_scene::load(&args.scene)?;
+    let mut scene = crate::load_scene(&args.scene)?;
     let names = scene.body_names.clone();
     let ids: Vec<tumble::BodyId> = scene.world.body_ids().to_vec();
     let label = |id: tumble::BodyId| {

@@ -114,6 +114,17 @@ impl From<tumble_scene::SceneError> for Failure {
     }
 }
 
+/// Loads what a command names: a built-in scene, a JSON scene file, or a model file (by
+/// extension, see `tumble_scene::FileKind`). What a model file held that could not be
+/// built as written is printed on stderr, a `warning: ` line each, and the run goes on.
+pub fn load_scene(name: &str) -> Result<tumble_scene::Scene, Failure> {
+    let scene = tumble_scene::load(name)?;
+    for warning in &scene.warnings {
+        let _ = writeln!(io::stderr(), "warning: {warning}");
+    }
+    Ok(scene)
+}
+
 /// Writing to standard output; a closed pipe is not an error worth a message.
 pub fn stdout_failure(e: io::Error) -> Failure {
     if e.kind() == io::ErrorKind::BrokenPipe {

@@ -22,7 +22,8 @@ const MAX_FRAMES: u64 = 108_000;
 /// Options of `tumble render`.
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Scene: a built-in name (see `tumble scenes`) or a JSON scene file.
+    /// Scene: a built-in name (see `tumble scenes`), a JSON scene file, or a URDF model
+    /// (`.urdf`: z-up gravity, base fixed).
     #[arg(value_name = "SCENE")]
     pub scene: String,
 
@@ -57,7 +58,8 @@ pub struct RenderArgs {
     pub height: u32,
 
     /// Eye position x,y,z (m, world frame). Default: framing every moving body over the
-    /// whole run, seen from +z, a little to the right and above.
+    /// whole run, seen from +z, a little to the right and above, with up against gravity
+    /// (+y without gravity; a URDF model's +z, when it is seen from −y).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
     pub camera: Option<String>,
 
@@ -192,7 +194,7 @@ impl Sink {
 /// Runs the command. A step that fails ends the run: the frames up to it are drawn and
 /// written, and the step's account is the error (exit 1).
 pub fn render(args: &RenderArgs) -> Result<(), Failure> {
-    let mut scene = tumble_scene::load(&args.scene)?;
+    let mut scene = crate::load_scene(&args.scene)?;
     if let Some(n) = args.threads {
         scene
             .world
@@ -280,10 +282,13 @@ fn camera(
     // A coarse model is enough to find the bounds: only radii are used.
     let bounds = Model::new(world, colours, f32::INFINITY).bounds(snapshots);
     let (min, max) = bounds.unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)));
-    let auto = Camera::framing(min, max, args.width, args.height);
+    // Up is against gravity (URDF models are z-up); +y in a world without gravity.
+    let g = world.gravity();
+    let up = -Vec3::new(narrow(g.x), narrow(g.y), narrow(g.z));
+    let auto = Camera::framing_up(min, max, up, args.width, args.height);
     let target = c.look_at.unwrap_or(auto.target);
     let eye = c.eye.unwrap_or(target + (auto.eye - auto.target));
-    let camera = Camera::look_at(eye, target, args.width, args.height).unwrap_or(auto);
+    let camera = Camera::look_at_up(eye, target, up, args.width, args.height).unwrap_or(auto);
     let scale = (max - min).length().max(0.5);
     (camera, scale)
 }

@@ -24,7 +24,8 @@ pub struct RunArgs {
     /// Scene to run: a built-in name (free_fall, spring, double_spring, dzhanibekov,
     /// planar_spinner, dumbbell, resting, door, cradle, rope_bridge, ragdoll, pyramid,
     /// pendulum_chain, character_course; see `tumble scenes`) or the path of a JSON scene
-    /// file (format: docs/scene-format.md). Built-in names win over files in the current
+    /// file (format: docs/scene-format.md), or a URDF model file (`.urdf`: run with z-up
+    /// gravity, its base fixed). Built-in names win over files in the current
     /// directory. Omitted: the seed's free fall, printed as a table against the analytic
     /// solution.
     #[arg(value_name = "SCENE")]
@@ -162,7 +163,7 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
         .map(tumble_scene::parse_integrator)
         .transpose()?;
     let scene_name = args.scene.as_deref().unwrap_or(SEED_SCENE);
-    let mut scene = tumble_scene::load(scene_name)?;
+    let mut scene = crate::load_scene(scene_name)?;
     if let Some(integrator) = integrator {
         scene.world.set_integrator(integrator);
     }

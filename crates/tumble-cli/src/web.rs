@@ -29,7 +29,8 @@ const MAX_FRAMES: u64 = 20_000;
 /// Options shared by `tumble export-html` and `tumble view`.
 #[derive(Args, Debug)]
 pub struct PageArgs {
-    /// Scene: a built-in name (see `tumble scenes`) or a JSON scene file.
+    /// Scene: a built-in name (see `tumble scenes`), a JSON scene file, or a URDF model
+    /// (`.urdf`: z-up gravity, base fixed).
     #[arg(value_name = "SCENE")]
     pub scene: String,
 
@@ -197,7 +198,7 @@ fn open_browser(url: &str) {
 /// The whole page for the options: run the scene, record it, wrap it with the viewer.
 /// The failure of a step, if one ended the run early, comes second.
 pub fn page(args: &PageArgs) -> Result<(String, Option<Failure>), Failure> {
-    let mut scene = tumble_scene::load(&args.scene)?;
+    let mut scene = crate::load_scene(&args.scene)?;
     if let Some(n) = args.threads {
         scene
             .world

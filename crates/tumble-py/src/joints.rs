@@ -199,7 +199,10 @@ impl PyJoint {
     }
 }
 
-fn joint_handle<'py>(world: &Bound<'py, PyWorld>, id: JointId) -> PyResult<Bound<'py, PyJoint>> {
+pub(crate) fn joint_handle<'py>(
+    world: &Bound<'py, PyWorld>,
+    id: JointId,
+) -> PyResult<Bound<'py, PyJoint>> {
     Bound::new(
         world.py(),
         PyJoint {

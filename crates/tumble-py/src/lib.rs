@@ -16,6 +16,7 @@ mod convert;
 mod joint_control;
 mod joints;
 mod mjcf;
+mod models;
 mod query;
 mod shapes;
 mod sim;
@@ -52,5 +53,6 @@ fn tumble_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     joints::register(m)?;
     character::register(m)?;
     callbacks::register(m)?;
+    models::register(m)?;
     Ok(())
 }

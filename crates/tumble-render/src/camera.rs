@@ -39,12 +39,26 @@ pub struct Projected {
 impl Camera {
     /// A camera at `eye` looking at `target`, world +y up. `None` if they coincide.
     pub fn look_at(eye: Vec3, target: Vec3, width: u32, height: u32) -> Option<Camera> {
+        Camera::look_at_up(eye, target, Vec3::Y, width, height)
+    }
+
+    /// [`Camera::look_at`] with `up` (any length; zero means +y) as the world's up: a
+    /// z-up model's pictures stand upright with `up` = +z.
+    pub fn look_at_up(
+        eye: Vec3,
+        target: Vec3,
+        up: Vec3,
+        width: u32,
+        height: u32,
+    ) -> Option<Camera> {
         let forward = (target - eye).try_normalize()?;
-        // Looking straight up or down, +y cannot be "up" on the picture: -z is.
+        let turn = turn_to(up);
+        // Looking straight up or down, up cannot be "up" on the picture: what -z is to a
+        // y-up world is.
         let right = forward
-            .cross(Vec3::Y)
+            .cross(turn * Vec3::Y)
             .try_normalize()
-            .unwrap_or_else(|| forward.cross(Vec3::NEG_Z).normalize());
+            .unwrap_or_else(|| forward.cross(turn * Vec3::NEG_Z).normalize());
         let up = right.cross(forward);
         let focal = 0.5 * height as f32 / (0.5 * FOV_Y).tan();
         Some(Camera {
@@ -62,14 +76,21 @@ impl Camera {
     /// A camera that keeps the box `min..max` in view, seen from the front (+z), a little
     /// to the right and above, as a person standing before a table would look.
     pub fn framing(min: Vec3, max: Vec3, width: u32, height: u32) -> Camera {
+        Camera::framing_up(min, max, Vec3::Y, width, height)
+    }
+
+    /// [`Camera::framing`] in a world whose up is `up` (zero means +y): the same view,
+    /// turned with the world.
+    pub fn framing_up(min: Vec3, max: Vec3, up: Vec3, width: u32, height: u32) -> Camera {
+        let turn = turn_to(up);
         let centre = (min + max) * 0.5;
         let radius = ((max - min).length() * 0.5).max(0.25);
         let aspect = width as f32 / height as f32;
         // The sphere around the box must fit the narrower of the two fields of view.
         let half_fov = (0.5 * FOV_Y).min((aspect * (0.5 * FOV_Y).tan()).atan());
         let distance = radius / half_fov.sin() * 1.05;
-        let direction = Vec3::new(0.45, 0.4, 1.0).normalize();
-        Camera::look_at(centre + direction * distance, centre, width, height)
+        let direction = turn * Vec3::new(0.45, 0.4, 1.0).normalize();
+        Camera::look_at_up(centre + direction * distance, centre, up, width, height)
             .expect("the direction is not zero")
     }
 
@@ -91,6 +112,14 @@ impl Camera {
             y: 0.5 * self.height as f32 - d.dot(self.up) * s,
             depth,
         })
+    }
+}
+
+/// The rotation taking +y to `up` (the identity for +y, or a zero or non-finite `up`).
+fn turn_to(up: Vec3) -> glam::Quat {
+    match up.try_normalize() {
+        Some(u) if u != Vec3::Y => glam::Quat::from_rotation_arc(Vec3::Y, u),
+        _ => glam::Quat::IDENTITY,
     }
 }
 

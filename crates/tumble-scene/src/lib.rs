@@ -18,11 +18,14 @@ mod character;
 mod error;
 mod force;
 mod joint;
+pub mod mesh_file;
 pub mod mjcf;
+mod models;
 mod plan;
 mod reader;
 mod save;
 mod shape;
+pub mod urdf;
 
 use std::fmt;
 use std::path::Path;
@@ -72,6 +75,7 @@ const TOP_KEYS: [&str; 25] = [
     "max_contacts_per_body",
     "max_push_speed",
     "character",
+    "models",
 ];
 
 /// The most `substeps` and `iterations` a scene or the command line may ask for.
@@ -102,6 +106,9 @@ pub struct Scene {
     /// The scene's `character`, walked along its path by [`Scene::step`]; its body is the
     /// last of the world's.
     pub character: Option<Walker>,
+    /// What a model file held that was read but not built as written, one line each
+    /// (see [`urdf::Imported::warnings`]); the CLI prints them.
+    pub warnings: Vec<String>,
 }
 
 impl Scene {
@@ -136,15 +143,51 @@ impl fmt::Debug for Scene {
     }
 }
 
-/// Reads a scene from JSON text.
+/// Reads a scene from JSON text. Model files its `models` name are found from the
+/// current directory.
 pub fn load_str(json: &str) -> Result<Scene> {
-    let value: Value = serde_json::from_str(json).map_err(json_error)?;
-    build(&Node::root(&value))
+    load_str_in(json, Path::new(""))
 }
 
-/// Reads a scene file.
+/// Reads a scene from JSON text whose `models` files are relative to `dir`.
+pub fn load_str_in(json: &str, dir: &Path) -> Result<Scene> {
+    let value: Value = serde_json::from_str(json).map_err(json_error)?;
+    build(&Node::root(&value), dir)
+}
+
+/// The kinds of file [`load_file`] reads, told apart by extension (any case): `urdf` a
+/// URDF model (see [`urdf::scene`]), `xml` an MJCF model (see [`mjcf::load_scene`]);
+/// anything else a JSON scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FileKind {
+    /// A JSON scene (docs/scene-format.md).
+    Scene,
+    /// A URDF model.
+    Urdf,
+    /// An MJCF (MuJoCo XML) model.
+    Mjcf,
+}
+
+impl FileKind {
+    /// The kind of `path`, by its extension.
+    pub fn of(path: &Path) -> FileKind {
+        let ext = path.extension().and_then(|e| e.to_str());
+        match ext.map(str::to_ascii_lowercase).as_deref() {
+            Some("urdf") => FileKind::Urdf,
+            Some("xml") => FileKind::Mjcf,
+            _ => FileKind::Scene,
+        }
+    }
+}
+
+/// Reads a scene file, or a model file run as a scene (by extension, see [`FileKind`]).
 pub fn load_file(path: impl AsRef<Path>) -> Result<Scene> {
     let path = path.as_ref();
+    match FileKind::of(path) {
+        FileKind::Urdf => return urdf::scene(path, &urdf::UrdfOptions::default()),
+        FileKind::Mjcf => return mjcf::load_scene(path).map(|(scene, _)| scene),
+        FileKind::Scene => {}
+    }
     let text = std::fs::read_to_string(path).map_err(|e| {
         SceneError::new(
             ROOT,
@@ -154,7 +197,7 @@ pub fn load_file(path: impl AsRef<Path>) -> Result<Scene> {
             ),
         )
     })?;
-    load_str(&text)
+    load_str_in(&text, path.parent().unwrap_or(Path::new("")))
 }
 
 /// Reads a built-in scene by name, or else a file by path. Built-in names win, so a file
@@ -162,8 +205,10 @@ pub fn load_file(path: impl AsRef<Path>) -> Result<Scene> {
 pub fn load(name_or_path: &str) -> Result<Scene> {
     match builtin(name_or_path) {
         Some(json) => load_str(json),
-        // MJCF models (MuJoCo XML) by extension; see `mjcf`.
-        None if mjcf::is_mjcf(name_or_path) => mjcf::load_scene(name_or_path).map(|(s, _)| s),
+        // Model files by extension, so that a missing one is named by its loader.
+        None if FileKind::of(Path::new(name_or_path)) != FileKind::Scene => {
+            load_file(name_or_path)
+        }
         None if Path::new(name_or_path).exists() => load_file(name_or_path),
         None => Err(SceneError::new(
             ROOT,
@@ -191,7 +236,7 @@ fn json_error(e: serde_json::Error) -> SceneError {
     )
 }
 
-fn build(root: &Node<'_>) -> Result<Scene> {
+fn build(root: &Node<'_>, dir: &Path) -> Result<Scene> {
     let obj = root.object()?;
     obj.only(&TOP_KEYS)?;
     let name = obj.str("name")?.map(str::to_string);
@@ -215,6 +260,7 @@ fn build(root: &Node<'_>) -> Result<Scene> {
     plan::check_settings(duration, dt)?;
     let mut world = World::try_new(&def).map_err(|e| SceneError::from_engine(e, ""))?;
     let (mut body_names, mut body_colors) = add_bodies(&obj, &mut world)?;
+    let warnings = models::add_models(&obj, dir, &mut world, &mut body_names, &mut body_colors)?;
     add_forces(&obj, &mut world)?;
     add_joints(&obj, &mut world)?;
     let character = match obj.get("character") {
@@ -238,6 +284,7 @@ fn build(root: &Node<'_>) -> Result<Scene> {
         body_names,
         body_colors,
         character,
+        warnings,
     })
 }
 

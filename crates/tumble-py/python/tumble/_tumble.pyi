@@ -451,6 +451,22 @@ class Joint:
     def velocity(self) -> JointCoordinate:
         """The coordinate's rate (rad/s or m/s); ball and fixed: relative angular velocity."""
 
+class Model:
+    """What a model file became in a world (World.add_urdf)."""
+
+    @property
+    def name(self) -> str:
+        """The file's model name (URDF's <robot name>)."""
+    @property
+    def bodies(self) -> dict[str, Body]:
+        """Each link by its name in the file; links merged by fixed joints share a body."""
+    @property
+    def joints(self) -> dict[str, Joint]:
+        """Each joint by its name in the file; `position` is the file's joint coordinate."""
+    @property
+    def warnings(self) -> list[str]:
+        """What was read but not built as written, one line each."""
+
 class World:
     """A simulated world: bodies, force elements, joints and the step."""
 
@@ -486,6 +502,29 @@ class World:
     def from_mjcf(path: Union[str, PathLike[str]]) -> World:
         """Loads an MJCF (MuJoCo XML) model: names, joints and gravity from the file;
         what is not read comes out as UserWarnings naming file, line and element."""
+    @staticmethod
+    def from_urdf(
+        path: Union[str, PathLike[str]],
+        *,
+        fixed_base: bool = True,
+        gravity: Optional[Vec3Like] = None,
+        position: Optional[Vec3Like] = None,
+        orientation: Optional[QuatLike] = None,
+        merge_fixed: bool = True,
+    ) -> World:
+        """A world holding a URDF model; gravity defaults to z-up (0, 0, -9.81).
+        Bodies and joints are named as in the file. ValueError names file:line and element."""
+    def add_urdf(
+        self,
+        path: Union[str, PathLike[str]],
+        *,
+        position: Optional[Vec3Like] = None,
+        orientation: Optional[QuatLike] = None,
+        fixed_base: bool = True,
+        merge_fixed: bool = True,
+        prefix: Optional[str] = None,
+    ) -> Model:
+        """Adds a URDF model (all or nothing) and returns its bodies and joints by name."""
     def add_body(
         self,
         shape: Shape,

@@ -213,13 +213,7 @@ pub fn load_scene(path: impl AsRef<Path>) -> Result<(Scene, ImportedMjcf)> {
         body_names,
         body_colors,
         character: None,
+        warnings: model.warnings.iter().map(ToString::to_string).collect(),
     };
     Ok((scene, model))
-}
-
-/// Whether a path names an MJCF file (by its `.xml` extension).
-pub fn is_mjcf(path: &str) -> bool {
-    Path::new(path)
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
 }
