@@ -49,9 +49,8 @@ pub use body::check_name;
 
 use reader::{Node, Obj};
 
-const TOP_KEYS: [&str; 25] = [
+const TOP_KEYS: [&str; 26] = [
     "name",
-    "state",
     "description",
     "gravity",
     "dt",
@@ -75,6 +74,7 @@ const TOP_KEYS: [&str; 25] = [
     "max_contacts_per_body",
     "max_push_speed",
     "character",
+    "state",
     "models",
 ];
 
@@ -206,9 +206,7 @@ pub fn load(name_or_path: &str) -> Result<Scene> {
     match builtin(name_or_path) {
         Some(json) => load_str(json),
         // Model files by extension, so that a missing one is named by its loader.
-        None if FileKind::of(Path::new(name_or_path)) != FileKind::Scene => {
-            load_file(name_or_path)
-        }
+        None if FileKind::of(Path::new(name_or_path)) != FileKind::Scene => load_file(name_or_path),
         None if Path::new(name_or_path).exists() => load_file(name_or_path),
         None => Err(SceneError::new(
             ROOT,
