@@ -47,7 +47,6 @@ use reader::{Node, Obj};
 
 const TOP_KEYS: [&str; 25] = [
     "name",
-    "state",
     "description",
     "gravity",
     "dt",
@@ -71,6 +70,7 @@ const TOP_KEYS: [&str; 25] = [
     "max_contacts_per_body",
     "max_push_speed",
     "character",
+    "state",
 ];
 
 /// The most `substeps` and `iterations` a scene or the command line may ask for.

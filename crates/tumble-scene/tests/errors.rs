@@ -40,7 +40,7 @@ fn misspelt_keys_are_refused_with_the_allowed_ones() {
         "gravityy: unknown key (expected one of: name, description, gravity, dt, duration, \
          integrator, bodies, forces, joints, solver, substeps, iterations, contact_hertz, \
          contact_damping_ratio, joint_hertz, joint_damping_ratio, length_unit, sleep, max_speed, \
-         max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed, character)"
+         max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed, character, state)"
     );
     assert_eq!(
         error(&one_body(r#""velocty": [1, 0, 0]"#)),
@@ -338,7 +338,7 @@ fn user_text_cannot_break_the_line() {
         "du\\nration: unknown key (expected one of: name, description, gravity, dt, duration, \
          integrator, bodies, forces, joints, solver, substeps, iterations, contact_hertz, \
          contact_damping_ratio, joint_hertz, joint_damping_ratio, length_unit, sleep, max_speed, \
-         max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed, character)"
+         max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed, character, state)"
     );
     assert_eq!(error(r#"{"integrator": "rk\n4"}"#).lines().count(), 1);
     assert_eq!(
