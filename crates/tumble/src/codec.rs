@@ -10,11 +10,15 @@
 //! The reader never panics and never allocates more than the bytes left could describe:
 //! a length is checked against the remaining bytes before anything is reserved.
 
-use crate::error::Error;
 use crate::math::{Mat3, Quat, Real, Vec3, Vec4};
 
+/// What is wrong with a snapshot's bytes, and where (it becomes `Error::Snapshot`; a type
+/// of its own so that this module, which the handles and limits use, imports no errors).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Malformed(pub String);
+
 /// The result of reading a value.
-pub(crate) type Decoded<T> = std::result::Result<T, Error>;
+pub(crate) type Decoded<T> = std::result::Result<T, Malformed>;
 
 /// Bytes being written.
 #[derive(Default)]
@@ -61,7 +65,7 @@ impl<'a> Reader<'a> {
     pub fn take<const N: usize>(&mut self) -> Decoded<[u8; N]> {
         let end = self.pos + N;
         let Some(slice) = self.bytes.get(self.pos..end) else {
-            return Err(Error::snapshot(format!(
+            return Err(Malformed(format!(
                 "truncated at byte {}",
                 self.base + self.bytes.len()
             )));
@@ -78,7 +82,7 @@ impl<'a> Reader<'a> {
         let at = self.offset();
         let n = u64::from_le_bytes(self.take()?);
         if n > self.remaining() as u64 {
-            return Err(Error::snapshot(format!(
+            return Err(Malformed(format!(
                 "length {n} at byte {at} is more than the {} bytes left",
                 self.remaining()
             )));
@@ -87,8 +91,8 @@ impl<'a> Reader<'a> {
     }
 
     /// An error for a bad tag of `what` read just before the current position.
-    pub fn bad_tag(&self, what: &str, tag: u8) -> Error {
-        Error::snapshot(format!(
+    pub fn bad_tag(&self, what: &str, tag: u8) -> Malformed {
+        Malformed(format!(
             "{what}: unknown tag {tag} at byte {}",
             self.offset() - 1
         ))
@@ -123,7 +127,7 @@ impl Code for usize {
     fn get(r: &mut Reader<'_>) -> Decoded<Self> {
         let at = r.offset();
         usize::try_from(u64::get(r)?)
-            .map_err(|_| Error::snapshot(format!("count too large at byte {at}")))
+            .map_err(|_| Malformed(format!("count too large at byte {at}")))
     }
 }
 
@@ -168,7 +172,10 @@ impl<T: Code> Code for Vec<T> {
     }
     fn get(r: &mut Reader<'_>) -> Decoded<Self> {
         let n = r.len()?;
-        let mut out = Vec::with_capacity(n);
+        // At most as many bytes reserved as are left to read: a count that lies is found
+        // out by running out of bytes, not by an allocation of gigabytes.
+        let fit = r.remaining() / std::mem::size_of::<T>().max(1);
+        let mut out = Vec::with_capacity(n.min(fit + 16));
         for _ in 0..n {
             out.push(T::get(r)?);
         }
@@ -228,8 +235,7 @@ impl Code for String {
             }
             v
         };
-        String::from_utf8(bytes)
-            .map_err(|_| Error::snapshot(format!("string at byte {at} is not UTF-8")))
+        String::from_utf8(bytes).map_err(|_| Malformed(format!("string at byte {at} is not UTF-8")))
     }
 }
 
@@ -292,6 +298,12 @@ macro_rules! codec_unit_enum {
 }
 
 pub(crate) use {codec_struct, codec_unit_enum};
+
+// Here rather than in id.rs, which error.rs imports: the handles' fields are public.
+use crate::id::{BodyId, ForceId, JointId};
+codec_struct!(BodyId { index, generation });
+codec_struct!(JointId { index, generation });
+codec_struct!(ForceId { index, generation });
 
 /// A 64-bit checksum of `bytes` (FNV-1a over 8-byte words, then the tail bytes): fast
 /// enough for megabytes per frame, and any changed byte changes it with overwhelming odds.

@@ -191,7 +191,7 @@ impl<H: Handle> crate::codec::Code for Handles<H> {
         let handles = Handles { slots, free, ids };
         if !handles.consistent() {
             let at = r.offset();
-            return Err(crate::error::Error::snapshot(format!(
+            return Err(crate::codec::Malformed(format!(
                 "handles ending at byte {at} do not match their slots"
             )));
         }

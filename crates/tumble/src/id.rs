@@ -27,7 +27,3 @@ pub struct ForceId {
     /// Generation of the slot when the force element was added.
     pub generation: u32,
 }
-
-crate::codec::codec_struct!(BodyId { index, generation });
-crate::codec::codec_struct!(JointId { index, generation });
-crate::codec::codec_struct!(ForceId { index, generation });
