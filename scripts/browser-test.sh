@@ -46,3 +46,8 @@ for scene in $(target/debug/tumble scenes | cut -d' ' -f1) viewer/test/every_sha
 done
 target/debug/tumble export-gltf viewer/test/every_shape.json --out "$gltf/every_shape.gltf" --quiet
 node viewer/test/gltf.mjs "$gltf"/*.glb "$gltf"/*.gltf
+
+# And in a glTF viewer: three.js's GLTFLoader in headless Chromium (viewer/test/gltf_three.mjs)
+# plays the falling ball's file; the ball is where the closed form puts it, in its colour.
+target/debug/tumble export-gltf viewer/test/falling.json --out "$gltf/falling.glb" --quiet
+CHROMIUM="$chromium" node viewer/test/gltf_three.mjs "$gltf/falling.glb" "$out"
