@@ -34,3 +34,20 @@ fi
 cargo test --locked -q -p tumble-cli --no-run
 target/debug/tumble export-html viewer/test/falling.json --out "$out/falling.html" --quiet
 CHROMIUM="$chromium" node viewer/test/browser.mjs "$out/falling.html" "$out"
+
+# tumble export-gltf's files through the Khronos glTF-Validator (viewer/test/gltf.mjs):
+# every built-in scene, every kind of shape (also as .gltf with its buffer embedded), a
+# z-up model.
+gltf="$out/gltf"
+rm -rf "$gltf" && mkdir -p "$gltf"
+for scene in $(target/debug/tumble scenes | cut -d' ' -f1) viewer/test/every_shape.json viewer/test/z_up.json; do
+    name=$(basename "$scene" .json)
+    target/debug/tumble export-gltf "$scene" --out "$gltf/$name.glb" --duration 0.5 --quiet
+done
+target/debug/tumble export-gltf viewer/test/every_shape.json --out "$gltf/every_shape.gltf" --quiet
+node viewer/test/gltf.mjs "$gltf"/*.glb "$gltf"/*.gltf
+
+# And in a glTF viewer: three.js's GLTFLoader in headless Chromium (viewer/test/gltf_three.mjs)
+# plays the falling ball's file; the ball is where the closed form puts it, in its colour.
+target/debug/tumble export-gltf viewer/test/falling.json --out "$gltf/falling.glb" --quiet
+CHROMIUM="$chromium" node viewer/test/gltf_three.mjs "$gltf/falling.glb" "$out"
