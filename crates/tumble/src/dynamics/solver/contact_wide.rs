@@ -176,12 +176,13 @@ impl ContactLanes {
         let sum_parts = Parts::new(&mut self.cold[..slots]);
         crate::team::pieces(par.threads, n.div_ceil(size), &|i| {
             let range = i * size..((i + 1) * size).min(n);
-            // SAFETY: piece i takes groups i·size.. alone, and the slots from its first
-            // group's slot0 to its last group's end: groups' slots are consecutive and
-            // disjoint (planned in order), so no two pieces' parts overlap.
+            // SAFETY: piece i takes groups i·size.. alone (each piece runs once).
             let groups = unsafe { groups.part(range) };
             let from = groups[0].slot0;
             let to = groups.last().map_or(from, |g| g.slot0 + g.slots);
+            // SAFETY: the slots from this piece's first group's slot0 to its last group's
+            // end: groups' slots were planned consecutive and disjoint, in group order,
+            // so pieces of disjoint groups get disjoint slots.
             let (slots, masks, sums) = unsafe {
                 (
                     slot_parts.part(from..to),
