@@ -327,16 +327,7 @@ fn frame_contents(
     let defaults = ctx.defaults;
     let v = View::new(elem, class, defaults)?;
     let pose = compose(pose, frame::frame(&v, &ctx.compiler)?);
-    let class = match elem.own("childclass") {
-        Some(c) if !defaults.has(c) => {
-            return Err(v.err(
-                "childclass",
-                format!("no <default class=\"{}\">", printable(c)),
-            ))
-        }
-        Some(c) => c,
-        None => class,
-    };
+    let class = child_class(elem, &v, defaults, class)?;
     if elem.kids("joint").next().is_some() || elem.kids("freejoint").next().is_some() {
         return Err(v.err("joint", "joints belong in a <body>, not a <frame>"));
     }
@@ -380,6 +371,24 @@ pub(crate) fn sum(parts: impl Iterator<Item = MassProperties>) -> MassProperties
     MassProperties::sum(parts)
 }
 
+/// The class an element's children take: its own `childclass` (which must be a defined
+/// `<default>` class), else `class`, the one it inherited.
+fn child_class<'a>(
+    elem: &'a Elem,
+    v: &View<'_>,
+    defaults: &Defaults,
+    class: &'a str,
+) -> Result<&'a str> {
+    match elem.own("childclass") {
+        Some(c) if !defaults.has(c) => Err(v.err(
+            "childclass",
+            format!("no <default class=\"{}\">", printable(c)),
+        )),
+        Some(c) => Ok(c),
+        None => Ok(class),
+    }
+}
+
 fn child_body(
     ctx: &mut Ctx<'_>,
     elem: &Elem,
@@ -390,16 +399,7 @@ fn child_body(
     let defaults = ctx.defaults;
     let v = View::new(elem, class, defaults)?;
     let pose = compose(parent_pose, frame::frame(&v, &ctx.compiler)?);
-    let child_class = match elem.own("childclass") {
-        Some(c) if !defaults.has(c) => {
-            return Err(v.err(
-                "childclass",
-                format!("no <default class=\"{}\">", printable(c)),
-            ))
-        }
-        Some(c) => c,
-        None => class,
-    };
+    let child_class = child_class(elem, &v, defaults, class)?;
     let joints: Vec<&Elem> = elem
         .children
         .iter()
