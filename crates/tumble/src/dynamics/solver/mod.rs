@@ -40,7 +40,7 @@ pub use softness::Softness;
 
 pub(crate) use body::{BodySim, BodyState, SolverBodies};
 use contact::{BiasRule, ContactConstraint, PairData, Points};
-use joint::{JointConstraint, JointPass};
+use joint::{Frame as JointFrame, JointConstraint, JointPass};
 
 use crate::collision::contact::{Contact, ContactMaterial};
 use crate::collision::narrow_phase::Overlap;
@@ -86,6 +86,9 @@ pub(crate) struct Solver {
     constraints: Vec<ContactConstraint>,
     points: Points,
     joints: Vec<JointConstraint>,
+    /// Each joint's frame at the current poses (see `joint::Frame`), made again after
+    /// every drift.
+    joint_frames: Vec<JointFrame>,
     /// Per body, whether its island has a large mass ratio (see `mass_ratio`); empty when
     /// none has. Such islands' contacts and joints sit at the end of their lists, from
     /// `heavy_contacts` and `heavy_joints`, and get `heavy_passes` times the passes.
@@ -227,8 +230,8 @@ impl Solver {
         if self.fine > 1 {
             self.fine_substeps(bodies, input, fine_rule);
         }
-        for j in &mut self.joints {
-            j.warm_start(&bodies.sims, &mut bodies.states);
+        for (j, fr) in self.joints.iter_mut().zip(&self.joint_frames) {
+            j.warm_start(fr, &mut bodies.states);
         }
         contact_wide::warm_start(
             &self.constraints,
@@ -241,6 +244,7 @@ impl Solver {
         let relax = input.settings.kind == SolverKind::SoftStep && iterations > 0;
         self.passes(bodies, iterations, (rule, solve_pass), true, !relax);
         self.drift(bodies, world_bodies, h, false);
+        self.make_joint_frames(&bodies.sims);
         if any_split {
             self.kick(bodies, input.system, t + h, h, (true, true));
         }
@@ -250,8 +254,8 @@ impl Solver {
         if iterations == 0 {
             ContactConstraint::add_to_totals(&self.points.hot, &mut self.points.cold);
         }
-        for j in &mut self.joints {
-            j.add_to_totals(&bodies.sims);
+        for (j, fr) in self.joints.iter_mut().zip(&self.joint_frames) {
+            j.add_to_totals(fr);
         }
     }
 
@@ -292,8 +296,9 @@ impl Solver {
         ];
         for (contacts, joints, count, (rule, joint_pass)) in parts {
             for k in 0..count {
-                for j in &mut self.joints[joints.clone()] {
-                    j.solve(&bodies.sims, &mut bodies.states, joint_pass);
+                let frames = &self.joint_frames[joints.clone()];
+                for (j, fr) in self.joints[joints.clone()].iter_mut().zip(frames) {
+                    j.solve(fr, &mut bodies.states, joint_pass);
                 }
                 let last = totals && k + 1 == count;
                 self.solve_pass(bodies, contacts.clone(), rule, bias, last);
@@ -617,6 +622,15 @@ impl Solver {
         self.heavy_joints = light.len();
         light.extend(heavy);
         self.joints = light;
+        self.make_joint_frames(&solver_bodies.sims);
+    }
+
+    /// Each joint's frame at the poses in `sims`; after each drift of the bodies outside
+    /// tall stacks (those of joints never are, see `stacks::tall_islands`).
+    fn make_joint_frames(&mut self, sims: &[BodySim]) {
+        self.joint_frames.clear();
+        self.joint_frames
+            .extend(self.joints.iter().map(|j| j.frame(sims)));
     }
 
     /// The contacts to solve, ordered so that neighbours in the list rarely share a moving
