@@ -618,19 +618,31 @@ impl Solver {
                 .flatten()
                 .any(|k| is_flagged(flags, k))
         };
-        let (mut light, heavy): (Vec<_>, Vec<_>) = self.joints.drain(..).partition(|c| !heavy(c));
-        self.heavy_joints = light.len();
-        light.extend(heavy);
-        self.joints = light;
+        if self.heavy.is_empty() {
+            self.heavy_joints = self.joints.len();
+        } else {
+            let (mut light, heavy): (Vec<_>, Vec<_>) =
+                self.joints.drain(..).partition(|c| !heavy(c));
+            self.heavy_joints = light.len();
+            light.extend(heavy);
+            self.joints = light;
+        }
         self.make_joint_frames(&solver_bodies.sims);
     }
 
     /// Each joint's frame at the poses in `sims`; after each drift of the bodies outside
     /// tall stacks (those of joints never are, see `stacks::tall_islands`).
     fn make_joint_frames(&mut self, sims: &[BodySim]) {
-        self.joint_frames.clear();
-        self.joint_frames
-            .extend(self.joints.iter().map(|j| j.frame(sims)));
+        let n = self.joints.len();
+        if self.joint_frames.len() != n {
+            self.joint_frames.clear();
+            self.joint_frames
+                .extend(self.joints.iter().map(|j| j.frame(sims)));
+            return;
+        }
+        for (j, fr) in self.joints.iter().zip(&mut self.joint_frames) {
+            j.write_frame(sims, fr);
+        }
     }
 
     /// The contacts to solve, ordered so that neighbours in the list rarely share a moving
