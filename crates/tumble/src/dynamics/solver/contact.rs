@@ -139,6 +139,9 @@ impl BorrowMut<Sums> for PointCold {
 /// `lanes` holds the wide passes' copy of the grouped manifolds' points, whose impulses
 /// are the current ones until [`Points::save_lanes`] copies them back; `angular` the
 /// rolling and twist rows of the manifolds that have them (see `super::angular`).
+/// Where a manifold's points are written: its own entries of `Points::hot` and `cold`.
+pub(crate) type PointsOut<'a> = (&'a mut [Point], &'a mut [PointCold]);
+
 #[derive(Debug, Default)]
 pub(crate) struct Points {
     pub hot: Vec<Point>,
@@ -207,7 +210,7 @@ impl PairData {
 
 /// One manifold as the solver works on it; its points are `count` entries of [`Points`]
 /// from `first`.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct ContactConstraint {
     a: usize,
     b: usize,
@@ -240,13 +243,13 @@ fn angular_rows(
     pair: &PairData,
     bodies: (&BodySim, &BodySim),
     tangents: [Vec3; 2],
-    points: &mut Points,
+    angular: &mut Vec<AngularRows>,
 ) -> Option<u32> {
     let (rolling, twist) = pair.angular;
     if rolling > 0.0 || twist > 0.0 {
         let rows = AngularRows::new(m, bodies, tangents, pair.angular);
-        points.angular.push(rows);
-        Some(points.angular.len() as u32 - 1)
+        angular.push(rows);
+        Some(angular.len() as u32 - 1)
     } else {
         None
     }
@@ -317,7 +320,7 @@ impl ContactConstraint {
         contact: &Contact,
         pair: &PairData,
         (sims, states): (&[BodySim], &[BodyState]),
-        points: &mut Points,
+        (first, out, angular): (usize, PointsOut<'_>, &mut Vec<AngularRows>),
     ) -> Self {
         let (a, b) = pair.bodies;
         let (friction, restitution) = pair.material;
@@ -351,18 +354,18 @@ impl ContactConstraint {
             },
             moves: (sa.moves, sb.moves),
             restitution,
-            first: points.hot.len(),
+            first,
             count: m.len(),
             colour,
-            angular: angular_rows(m, pair, (sa, sb), tangents, points),
+            angular: angular_rows(m, pair, (sa, sb), tangents, angular),
         };
         // Two builds of one loop: with the test for rolled anchors folded into the
         // `false` one, every box contact cost 40 more instructions (measured on the
         // pyramid, where it never renews anything).
         if pair.rolls() {
-            c.add_points::<true>(contact, pair, sims, states, points);
+            c.add_points::<true>(contact, pair, (sims, states), out);
         } else {
-            c.add_points::<false>(contact, pair, sims, states, points);
+            c.add_points::<false>(contact, pair, (sims, states), out);
         }
         c
     }
@@ -389,21 +392,22 @@ impl ContactConstraint {
         }
     }
 
-    /// Appends the manifold's points to `points`: anchors, rows, warm starts. `ROLLS`:
+    /// Writes the manifold's points into `out` (as many as it has): anchors, rows, warm
+    /// starts. `ROLLS`:
     /// the pair rolls (`PairData::rolls`), and its points' anchors are renewed where they
     /// rolled away (see [`rolled_away`]).
     fn add_points<const ROLLS: bool>(
         &self,
         contact: &Contact,
         pair: &PairData,
-        sims: &[BodySim],
-        states: &[BodyState],
-        points: &mut Points,
+        (sims, states): (&[BodySim], &[BodyState]),
+        (hot, cold): PointsOut<'_>,
     ) {
         let (a, b) = pair.bodies;
         let (sa, sb) = (&sims[a], &sims[b]);
         let (normal, tangents, poses) = (self.frame.normal, self.frame.tangents, pair.poses);
-        for mp in contact.manifold.points() {
+        let outs = hot.iter_mut().zip(cold);
+        for (mp, (hot, cold)) in contact.manifold.points().iter().zip(outs) {
             let at = contact_point(mp, pair.round);
             let anchors = mp.anchored.then(|| {
                 (
@@ -414,7 +418,7 @@ impl ContactConstraint {
             let rolled = ROLLS && anchors.is_some_and(|w| rolled_away(w, at, pair.slop));
             let (ra, rb) = (at - sa.x, at - sb.x);
             let normal_row = Row::new(normal, ra, rb, sa, sb);
-            points.hot.push(Point {
+            *hot = Point {
                 ra,
                 rb,
                 separation: mp.separation,
@@ -437,11 +441,11 @@ impl ContactConstraint {
                     _ => [0.0; 2],
                 },
                 tangent_lever: [tangents[0].dot(rb - ra), tangents[1].dot(rb - ra)],
-            });
+            };
             let start_velocity = Pair::load(&states[a], &states[b]);
             let start_velocity = normal_row.velocity(normal, ra, rb, &start_velocity);
             let fall = pair.gravity.map(|(ga, gb)| normal.dot(gb - ga));
-            points.cold.push(PointCold {
+            *cold = PointCold {
                 sums: Sums {
                     approach_velocity: start_velocity,
                     ..Sums::default()
@@ -451,7 +455,7 @@ impl ContactConstraint {
                 fall,
                 rolled,
                 ..PointCold::default()
-            });
+            };
         }
     }
 

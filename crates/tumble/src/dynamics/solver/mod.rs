@@ -50,6 +50,7 @@ use crate::dynamics::force::Wrench;
 use crate::dynamics::integrate::{exact_spin, rotor_drift, System};
 use crate::dynamics::joint::Joint;
 use crate::math::{Mat3, Real, Vec3};
+use crate::team::Parts;
 use crate::threads::Par;
 use std::ops::Range;
 
@@ -470,61 +471,60 @@ impl Solver {
         self.points.clear();
         self.deep.clear();
         let order = self.colour_order(&bodies.sims, contacts, ghosts);
-        let falls = |s: &BodySim| {
-            if s.moves {
-                gravity * s.linear_mask * s.gravity_scale
-            } else {
-                Vec3::ZERO
-            }
-        };
         self.heavy_contacts = order.partition_point(|&(part, _, _)| part < Part::Heavy as u8);
         self.tall_contacts = order.partition_point(|&(part, _, _)| part < Part::Tall as u8);
-        for (part, colour, i) in order {
+        // Each constraint's first point: the constraints and their points are written in
+        // place, in pieces on the step's team, so the lists take their final lengths first.
+        let mut firsts = Vec::with_capacity(order.len() + 1);
+        let mut total = 0;
+        for &(_, _, i) in &order {
+            firsts.push(total);
+            total += contacts[i].manifold.len();
+        }
+        firsts.push(total);
+        self.constraints
+            .resize(order.len(), ContactConstraint::default());
+        self.points.hot.resize(total, Default::default());
+        self.points.cold.resize(total, Default::default());
+        let sims = &bodies.sims;
+        let with = PrepareWith {
+            bodies: (bodies, world_bodies),
+            contacts: (contacts, materials),
+            slop,
+            gravity,
+            order: &order,
+            firsts: &firsts,
+        };
+        // Rolling and twist rows are listed in order in one list of their own: a step
+        // with any is prepared on one thread.
+        let angular = order.iter().any(|&(_, _, i)| {
             let c = &contacts[i];
-            let (a, b) = (c.index_a as usize, c.index_b as usize);
-            let (sa, sb) = (&bodies.sims[a], &bodies.sims[b]);
-            let (friction, restitution, surface) = match materials.get(i) {
-                Some(m) => (m.friction, m.restitution, m.surface_velocity),
-                None => (
-                    (sa.friction * sb.friction).sqrt(),
-                    sa.restitution.max(sb.restitution),
-                    Vec3::ZERO,
-                ),
-            };
-            let pose = |k: usize| {
-                let s = &bodies.sims[k];
-                crate::collision::geometry::Pose::new(s.x - s.q * s.local_center, s.q)
-            };
-            let pair = PairData {
-                bodies: (a, b),
-                material: (friction, restitution),
-                surface,
-                angular: angular::combine(sa, sb),
-                poses: (pose(a), pose(b)),
-                round: (
-                    sa.round.unwrap_or_else(|| {
-                        world_bodies[a].shape.round_radius(c.manifold.subshape_a)
-                    }),
-                    sb.round.unwrap_or_else(|| {
-                        world_bodies[b].shape.round_radius(c.manifold.subshape_b)
-                    }),
-                ),
-                slop,
-                gravity: (!(sa.moves && sb.moves) || gravity == Vec3::ZERO)
-                    .then(|| (falls(sa), falls(sb))),
-            };
-            let first = self.points.hot.len();
-            self.constraints.push(ContactConstraint::prepare(
-                (i, colour),
-                c,
-                &pair,
-                (&bodies.sims, &bodies.states),
-                &mut self.points,
-            ));
-            let k = self.constraints.len() - 1;
+            let (r, t) = angular::combine(&sims[c.index_a as usize], &sims[c.index_b as usize]);
+            r > 0.0 || t > 0.0
+        });
+        let pieces = if angular {
+            1
+        } else {
+            self.par.pieces(order.len(), CONSTRAINTS_A_PIECE)
+        };
+        if pieces <= 1 {
+            let out = (&mut self.points.hot[..], &mut self.points.cold[..]);
+            with.piece(
+                0..order.len(),
+                &mut self.constraints,
+                out,
+                &mut self.points.angular,
+            );
+        } else {
+            self.prepare_in_pieces(&with, pieces);
+        }
+        // What the pieces leave: each constraint fitted to its part, and the points that
+        // overlap too deeply found, in order (each touches its own constraint's points).
+        for (k, &(part, _, i)) in order.iter().enumerate() {
+            let c = &contacts[i];
             self.fit_to_part(k, part, c.manifold.fine, &spring);
             if c.manifold.overlap != Overlap::Clear {
-                self.find_deep(c, (k, first), &allow);
+                self.find_deep(c, (k, firsts[k]), &allow);
             }
         }
         self.points.group_lanes(
@@ -532,6 +532,31 @@ impl Solver {
             [self.heavy_contacts, self.tall_contacts],
             self.par,
         );
+    }
+
+    /// [`PrepareWith::piece`] over `pieces` consecutive runs of the order on the step's
+    /// team, each writing its own constraints and their points (no pair of the step has
+    /// angular rows).
+    fn prepare_in_pieces(&mut self, with: &PrepareWith<'_>, pieces: usize) {
+        let n = with.order.len();
+        let size = n.div_ceil(pieces).max(1);
+        let constraints = Parts::new(&mut self.constraints[..]);
+        let hot = Parts::new(&mut self.points.hot[..]);
+        let cold = Parts::new(&mut self.points.cold[..]);
+        crate::team::pieces(self.par.threads, n.div_ceil(size), &|i| {
+            let range = i * size..((i + 1) * size).min(n);
+            let at = with.firsts[range.start]..with.firsts[range.end];
+            // SAFETY: piece i takes constraints i·size.. (i+1)·size alone, and the points
+            // from the first's first to the last's end: `firsts` rises, so the pieces'
+            // point ranges are disjoint too (each piece runs once).
+            let (cs, out) = unsafe {
+                (
+                    constraints.part(range.clone()),
+                    (hot.part(at.clone()), cold.part(at)),
+                )
+            };
+            with.piece(range, cs, out, &mut Vec::new());
+        });
     }
 
     /// The points of constraint `k` (contact `c`, its points from `first`) deeper than
@@ -776,6 +801,92 @@ impl Solver {
             }
         };
         self.per_body(solver_bodies, &work);
+    }
+}
+
+/// Fewest constraints worth a piece of the preparation on another thread (one is some
+/// half a microsecond; a hand-off to the team about one).
+const CONSTRAINTS_A_PIECE: usize = 64;
+
+/// What preparing the contacts reads: the bodies, the contacts and their materials, the
+/// contact slop and gravity, the solver's order of the contacts and each one's first point.
+struct PrepareWith<'a> {
+    bodies: (&'a SolverBodies, &'a [Body]),
+    contacts: (&'a [Contact], &'a [ContactMaterial]),
+    slop: Real,
+    gravity: Vec3,
+    order: &'a [(u8, u32, usize)],
+    firsts: &'a [usize],
+}
+
+impl PrepareWith<'_> {
+    /// Prepares the constraints `range` of the order into `cs` and their points into
+    /// `out` (theirs alone, from the range's first point), rolling and twist rows onto
+    /// `angular`.
+    fn piece(
+        &self,
+        range: Range<usize>,
+        cs: &mut [ContactConstraint],
+        (hot, cold): contact::PointsOut<'_>,
+        angular: &mut Vec<angular::AngularRows>,
+    ) {
+        let (bodies, _) = self.bodies;
+        let base = self.firsts[range.start];
+        for (k, c_out) in range.zip(cs) {
+            let (_, colour, i) = self.order[k];
+            let c = &self.contacts.0[i];
+            let at = self.firsts[k] - base..self.firsts[k + 1] - base;
+            let out = (&mut hot[at.clone()], &mut cold[at]);
+            *c_out = ContactConstraint::prepare(
+                (i, colour),
+                c,
+                &self.pair(i),
+                (&bodies.sims, &bodies.states),
+                (self.firsts[k], out, angular),
+            );
+        }
+    }
+
+    /// What contact `i`'s pair brings to its constraint.
+    fn pair(&self, i: usize) -> PairData {
+        let ((bodies, world_bodies), (contacts, materials)) = (self.bodies, self.contacts);
+        let c = &contacts[i];
+        let (a, b) = (c.index_a as usize, c.index_b as usize);
+        let (sa, sb) = (&bodies.sims[a], &bodies.sims[b]);
+        let (friction, restitution, surface) = match materials.get(i) {
+            Some(m) => (m.friction, m.restitution, m.surface_velocity),
+            None => (
+                (sa.friction * sb.friction).sqrt(),
+                sa.restitution.max(sb.restitution),
+                Vec3::ZERO,
+            ),
+        };
+        let pose =
+            |s: &BodySim| crate::collision::geometry::Pose::new(s.x - s.q * s.local_center, s.q);
+        let gravity = self.gravity;
+        let falls = |s: &BodySim| {
+            if s.moves {
+                gravity * s.linear_mask * s.gravity_scale
+            } else {
+                Vec3::ZERO
+            }
+        };
+        PairData {
+            bodies: (a, b),
+            material: (friction, restitution),
+            surface,
+            angular: angular::combine(sa, sb),
+            poses: (pose(sa), pose(sb)),
+            round: (
+                sa.round
+                    .unwrap_or_else(|| world_bodies[a].shape.round_radius(c.manifold.subshape_a)),
+                sb.round
+                    .unwrap_or_else(|| world_bodies[b].shape.round_radius(c.manifold.subshape_b)),
+            ),
+            slop: self.slop,
+            gravity: (!(sa.moves && sb.moves) || gravity == Vec3::ZERO)
+                .then(|| (falls(sa), falls(sb))),
+        }
     }
 }
 
