@@ -6,7 +6,7 @@ use std::collections::BTreeSet;
 
 use tumble::{
     BodyDef, BodyId, BodyKind, CompoundChild, InertiaSpec, JointDef, JointId, JointKind,
-    MassProperties, MassSpec, Quat, Real, Servo, Shape, Vec3, World,
+    MassProperties, MassSpec, Quat, Real, Servo, Shape, TriMesh, Vec3, World,
 };
 
 use super::build::{Plan, PlanBody, PlanJoint, LIGHT};
@@ -152,6 +152,7 @@ fn create_body(
     }
     if !b.dynamic {
         static_planes(b, &def, world, made)?;
+        static_meshes(b, &def, world, made)?;
         if children.is_empty() {
             return Ok(None);
         }
@@ -203,6 +204,38 @@ fn static_planes(b: &PlanBody, def: &BodyDef, world: &mut World, made: &mut Made
         let id = world
             .create_body(&plane_def, Shape::plane(normal, offset))
             .map_err(|e| SceneError::new(b.label.clone(), e.to_string()))?;
+        made.bodies.push(id);
+        made.colors.push((id, g.rgb));
+    }
+    Ok(())
+}
+
+/// A static body's colliding mesh geoms, each a static body of its own with the mesh's
+/// triangles (meshes join no compound).
+fn static_meshes(b: &PlanBody, def: &BodyDef, world: &mut World, made: &mut Made) -> Result<()> {
+    for g in &b.geoms {
+        let Some(mesh) = &g.triangles else {
+            continue;
+        };
+        let vertices = mesh
+            .0
+            .iter()
+            .map(|p| g.position + g.orientation * *p)
+            .collect();
+        let shape = TriMesh::new(vertices, mesh.1.clone())
+            .map(Shape::TriMesh)
+            .map_err(|e| {
+                SceneError::new(g.label.clone(), SceneError::from_engine(e, "").to_string())
+            })?;
+        let mesh_def = BodyDef {
+            name: None,
+            kind: BodyKind::Static,
+            friction: g.friction,
+            ..def.clone()
+        };
+        let id = world
+            .create_body(&mesh_def, shape)
+            .map_err(|e| SceneError::new(g.label.clone(), e.to_string()))?;
         made.bodies.push(id);
         made.colors.push((id, g.rgb));
     }
