@@ -33,6 +33,54 @@ impl PyWorld {
             dt: s.dt,
             duration: s.duration,
             callbacks: None,
+            mjcf: Some(model),
         }))
+    }
+
+    /// The names of the actuators of the MJCF model the world was loaded from
+    /// (`from_mjcf`), in file order; empty for other worlds.
+    #[getter]
+    fn actuators(&self) -> PyResult<Vec<String>> {
+        let g = self.lock()?;
+        Ok(g.mjcf
+            .iter()
+            .flat_map(|m| m.actuators.iter().map(|a| a.name.clone()))
+            .collect())
+    }
+
+    /// Sets the control (MuJoCo's `ctrl`) of the actuator called `name` in the MJCF file,
+    /// clamped to its `ctrlrange` as MuJoCo does: a motor's torque gear·ctrl, a position
+    /// servo's target, a velocity servo's speed. Wakes the joint's bodies. An unknown
+    /// name or a value that is not finite raises ValueError (`actuator 'x': ...`) and
+    /// changes nothing.
+    fn set_control(&self, name: &str, value: f64) -> PyResult<()> {
+        let mut g = self.lock()?;
+        let Inner { world, mjcf, .. } = &mut *g;
+        let Some(model) = mjcf.as_mut() else {
+            return Err(scene(tumble_scene::SceneError::new(
+                format!("actuator '{}'", tumble_scene::printable(name)),
+                "no such actuator (the world was not loaded from an MJCF file)",
+            )));
+        };
+        model
+            .set_control(world, name, crate::convert::real(value))
+            .map_err(scene)
+    }
+
+    /// The control of actuator `name` as last set (after clamping to `ctrlrange`); 0
+    /// until set. ValueError for an unknown name.
+    fn control(&self, name: &str) -> PyResult<f64> {
+        let g = self.lock()?;
+        g.mjcf
+            .iter()
+            .flat_map(|m| m.actuators.iter())
+            .find(|a| a.name == name)
+            .map(|a| crate::convert::wide(a.control))
+            .ok_or_else(|| {
+                scene(tumble_scene::SceneError::new(
+                    format!("actuator '{}'", tumble_scene::printable(name)),
+                    "no such actuator",
+                ))
+            })
     }
 }

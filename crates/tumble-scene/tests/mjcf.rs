@@ -914,3 +914,62 @@ fn bad_meshes_give_one_line_naming_the_element() {
         assert_eq!(world.body_count(), 0);
     }
 }
+
+/// MJCF files in a scene's `models`: placed and prefixed, their bodies and joints named
+/// as in the file for the scene's joints; the scene's gravity stays (the file's
+/// `<option>` is not read).
+#[test]
+fn a_scene_places_mjcf_models_whose_bodies_its_joints_can_name() {
+    let file = model("cartpole.xml");
+    let file = file.to_str().unwrap();
+    let scene = format!(
+        r#"{{"gravity": [0, 0, -5],
+      "bodies": [{{"name": "ball", "shape": {{"type": "sphere", "radius": 0.1}}, "mass": 1,
+                  "position": [0, 0, 3]}}],
+      "models": [
+        {{"file": "{file}"}},
+        {{"file": "{file}", "prefix": "b_", "position": [3, 0, 0], "orientation": [0, 0, 1, 0]}}],
+      "joints": [{{"type": "fixed", "body": "ball", "other": "b_cart"}}]}}"#
+    );
+    let path = write("mjcf_scene.json", &scene);
+    let s = tumble_scene::load(path.to_str().unwrap()).unwrap();
+    for name in ["ball", "cart", "pole", "b_cart", "b_pole"] {
+        assert!(
+            s.body_names.iter().any(|n| n == name),
+            "{name}: {:?}",
+            s.body_names
+        );
+    }
+    assert_eq!(s.body_names.len(), s.world.body_count());
+    assert_eq!(s.body_colors.len(), s.world.body_count());
+    let w = &s.world;
+    assert_eq!(w.gravity(), Vec3::new(0.0, 0.0, -5.0));
+    // The pole's centre: 0.3 m up its axis, tilted 20° about y, then the model turned
+    // half a turn about z and moved 3 m along x.
+    let a = (20.0 as Real).to_radians();
+    let expected = Vec3::new(3.0 - 0.3 * a.sin(), 0.0, 1.0 + 0.3 * a.cos());
+    let pole = w.body(w.find_body("b_pole").unwrap()).unwrap();
+    assert!(
+        (pole.center_of_mass() - expected).length() < 1e-6,
+        "{}",
+        pole.center_of_mass()
+    );
+    assert!(w.find_joint("b_hinge").is_some() && w.find_joint("hinge").is_some());
+    assert_eq!(w.joints().count(), 5);
+
+    let bad = |models: &str| {
+        let path = write("bad_models.json", &format!(r#"{{"models": [{models}]}}"#));
+        tumble_scene::load(path.to_str().unwrap())
+            .unwrap_err()
+            .to_string()
+    };
+    assert_eq!(
+        bad(&format!(r#"{{"file": "{file}", "fixed_base": true}}"#)),
+        "models[0].fixed_base: not used for MJCF models (the file says which bodies move)"
+    );
+    let missing = bad(r#"{"file": "gone.xml"}"#);
+    assert!(
+        missing.starts_with("models[0]: gone.xml: cannot read"),
+        "{missing}"
+    );
+}

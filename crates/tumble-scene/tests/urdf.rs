@@ -717,7 +717,7 @@ fn a_scene_places_models_whose_links_its_joints_can_name() {
     );
     assert_eq!(
         bad(r#"{"file": "double.json"}"#),
-        "models[0].file: expected a model file ending in .urdf"
+        "models[0].file: expected a model file ending in .urdf or .xml (MJCF)"
     );
     let missing = bad(r#"{"file": "gone.urdf"}"#);
     assert!(

@@ -29,7 +29,7 @@ struct Made {
 /// Creates the plan in `world`; on an error, removes what it created.
 pub(crate) fn create(plan: Plan, world: &mut World, options: &MjcfOptions) -> Result<ImportedMjcf> {
     let mut made = Made::default();
-    match create_all(&plan, world, &mut made) {
+    match create_all(&plan, world, &mut made, &options.prefix) {
         Ok(ids) => {
             if options.world_settings {
                 world
@@ -58,7 +58,7 @@ struct Ids {
     joints: Vec<JointId>,
 }
 
-fn create_all(plan: &Plan, world: &mut World, made: &mut Made) -> Result<Ids> {
+fn create_all(plan: &Plan, world: &mut World, made: &mut Made, prefix: &str) -> Result<Ids> {
     let filters = if plan.settings.contacts {
         filters(plan)
     } else {
@@ -66,12 +66,13 @@ fn create_all(plan: &Plan, world: &mut World, made: &mut Made) -> Result<Ids> {
     };
     let mut bodies = Vec::with_capacity(plan.bodies.len());
     for (i, b) in plan.bodies.iter().enumerate() {
-        let id = create_body(plan, b, filters[i], world, made)?;
+        let id = create_body(plan, b, filters[i], prefix, world, made)?;
         bodies.push(id);
     }
     let mut joints = Vec::new();
     for (i, j) in plan.joints.iter().enumerate() {
-        let def = joint_def(plan, j, plan.servos[i], &bodies, world)?;
+        let mut def = joint_def(plan, j, plan.servos[i], &bodies, world)?;
+        def.name = Some(format!("{prefix}{}", j.name));
         let id = world
             .create_joint(&def)
             .map_err(|e| SceneError::new(j.label.clone(), e.to_string()))?;
@@ -123,6 +124,7 @@ fn create_body(
     plan: &Plan,
     b: &PlanBody,
     filter: (u32, u32),
+    prefix: &str,
     world: &mut World,
     made: &mut Made,
 ) -> Result<Option<BodyId>> {
@@ -139,7 +141,7 @@ fn create_body(
         })
         .collect();
     let mut def = BodyDef {
-        name: b.name.clone(),
+        name: b.name.as_ref().map(|n| format!("{prefix}{n}")),
         position: b.position,
         orientation: b.orientation,
         collision_group: filter.0,

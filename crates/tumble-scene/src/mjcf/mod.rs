@@ -57,6 +57,9 @@ pub struct MjcfOptions {
     /// Whether `<option>` sets the world's gravity and integrator (true when the model
     /// makes the world, false when it is added to a scene).
     pub world_settings: bool,
+    /// Put before every body and joint name in the world (the [`ImportedMjcf`]'s names
+    /// stay the file's), so that one file can be added twice.
+    pub prefix: String,
 }
 
 impl Default for MjcfOptions {
@@ -65,6 +68,7 @@ impl Default for MjcfOptions {
             position: Vec3::ZERO,
             orientation: Quat::IDENTITY,
             world_settings: true,
+            prefix: String::new(),
         }
     }
 }
