@@ -162,7 +162,7 @@ fn declare(
         None => Quat::IDENTITY,
         Some(q) => {
             let q = Quat::from_xyzw(q[1], q[2], q[3], q[0]);
-            if !(q.length() > 1e-12) {
+            if q.length() < 1e-12 {
                 return Err(v.err("refquat", "must not be zero"));
             }
             q.normalize()
@@ -395,7 +395,7 @@ fn check_volume(volume: Real, elem: &Elem) -> Result<()> {
     if volume < 0.0 {
         return Err(elem.err("mesh volume is negative (its triangles face inwards)"));
     }
-    if !(volume > 1e-15) {
+    if volume.is_nan() || volume <= 1e-15 {
         return Err(elem.err("mesh has no volume"));
     }
     Ok(())
