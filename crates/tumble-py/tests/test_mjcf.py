@@ -222,7 +222,7 @@ def mesh_model(tmp_path):
     for i, (mesh, extra) in enumerate([
         ("box", 'pos="0.1 0.2 0.3" euler="10 20 30" density="800"'),
         ("tetra", 'mass="2" quat="0.9 0.1 0.3 0.2"'),
-        ("u_legacy", ""), ("u_exact", ""), ("u_convex", ""),
+        ("u_legacy", ""), ("u_exact", ""), ("u_convex", ""), ("mirrored", 'mass="3"'),
     ]):
         bodies.append(
             f'<body name="{mesh}" pos="{i} 0 1"><freejoint/>'
@@ -230,6 +230,7 @@ def mesh_model(tmp_path):
         )
     text = f"""<mujoco><compiler assetdir="assets"/>
       <asset><mesh file="box.obj" scale="1 2 3"/><mesh file="tetra.stl"/>
+        <mesh name="mirrored" file="box.obj" scale="-1 2 0.5"/>
         <mesh name="u_legacy" file="u.obj"/><mesh name="u_exact" file="u.obj" inertia="exact"/>
         <mesh name="u_convex" file="u.obj" inertia="convex" refpos="0.1 0 0" refquat="0.9 0 0.3 0"/>
       </asset><worldbody>{"".join(bodies)}</worldbody></mujoco>"""
@@ -246,7 +247,7 @@ def test_mesh_bodies_weigh_and_balance_as_in_mujoco(tmp_path):
     model = mujoco.MjModel.from_xml_path(str(path))
     world = tumble.World.from_mjcf(path)
     masses = {}
-    for name in ["box", "tetra", "u_legacy", "u_exact", "u_convex"]:
+    for name in ["box", "tetra", "u_legacy", "u_exact", "u_convex", "mirrored"]:
         i = model.body(name).id
         body = world.body(name)
         masses[name] = body.mass
