@@ -1,5 +1,6 @@
 //! `tumble.World.from_mjcf`: a world from an MJCF (MuJoCo XML) model, through
-//! `tumble_scene::mjcf`. What the file has that the import does not read comes out as
+//! `tumble_scene::mjcf`, and its actuators' controls (`actuators`, `set_control`,
+//! `control`). What the file has that the import does not read comes out as
 //! Python warnings (UserWarning), one per kind, each naming the file, line and element.
 
 use std::ffi::CString;
@@ -17,7 +18,8 @@ impl PyWorld {
     /// file's `<option>` gravity (default (0, 0, -9.81): MJCF is z-up) and integrator;
     /// its timestep becomes `simulate`'s default `dt`. Bodies and joints keep the file's
     /// names (`world.joint("elbow")`), and a hinge's or slide's `position` is MuJoCo's
-    /// qpos minus the joint's `ref` (0 unless the file sets it). Bad files raise
+    /// qpos minus the joint's `ref` (0 unless the file sets it). The file's actuators are
+    /// kept: `world.actuators`, `world.set_control(name, value)`. Bad files raise
     /// ValueError naming the file, line and element, e.g.
     /// `arm.xml:12: <geom name="upper">: size: must be > 0, got -0.1`.
     #[staticmethod]
