@@ -105,6 +105,7 @@ impl PyWorld {
             dt: tumble_scene::DEFAULT_DT,
             duration: tumble_scene::DEFAULT_DURATION,
             callbacks: None,
+            mjcf: None,
         }))
     }
 

@@ -17,6 +17,7 @@ fn restored(data: &[u8], dt: Real, duration: Real) -> PyResult<PyWorld> {
         dt,
         duration,
         callbacks: None,
+        mjcf: None,
     }))
 }
 

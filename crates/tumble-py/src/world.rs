@@ -30,6 +30,9 @@ pub struct Inner {
     pub duration: Real,
     /// The world's Python force callbacks (`callbacks.rs`); `None` while it has none.
     pub callbacks: Option<crate::callbacks::Callbacks>,
+    /// What `World.from_mjcf` read (the actuators `set_control` drives); `None` for
+    /// worlds made otherwise.
+    pub mjcf: Option<tumble_scene::mjcf::ImportedMjcf>,
 }
 
 /// A simulated world: bodies, force elements, joints, and the step that advances them.
@@ -386,6 +389,7 @@ impl PyWorld {
             dt: tumble_scene::DEFAULT_DT,
             duration: tumble_scene::DEFAULT_DURATION,
             callbacks: None,
+            mjcf: None,
         }))
     }
 
@@ -401,6 +405,7 @@ impl PyWorld {
             dt: s.dt,
             duration: s.duration,
             callbacks: None,
+            mjcf: None,
         }))
     }
 
@@ -413,6 +418,7 @@ impl PyWorld {
             dt: s.dt,
             duration: s.duration,
             callbacks: None,
+            mjcf: None,
         }))
     }
 

@@ -112,8 +112,9 @@ def test_suite_models_load_run_and_weigh_what_mujoco_says(name):
 
 
 # Models with several joints in one body: Tumble adds a light body (1/1000 of the body's
-# mass) per extra joint, so their totals come out up to 0.3% heavier; dog reads no meshes.
-HEAVIER = ["ball_in_cup", "cheetah", "fish", "hopper", "humanoid", "humanoid_CMU",
+# mass) per extra joint, so their totals come out up to 0.3% heavier. dog's bones are
+# 163 STL meshes whose volumes (MuJoCo's legacy mesh inertia) make most of its mass.
+HEAVIER = ["ball_in_cup", "cheetah", "dog", "fish", "hopper", "humanoid", "humanoid_CMU",
            "manipulator", "point_mass", "quadruped", "stacker", "swimmer", "walker"]
 
 
@@ -159,3 +160,230 @@ def test_unread_parts_come_out_as_warnings(tmp_path):
     )
     with pytest.warns(UserWarning, match=r"tendon\.xml:3: <tendon>: <tendon>: not read"):
         tumble.World.from_mjcf(f)
+
+
+# --- mesh geoms -----------------------------------------------------------------------
+
+BOX_FACES = [(0, 2, 1), (0, 3, 2), (4, 5, 6), (4, 6, 7), (0, 1, 5), (0, 5, 4),
+             (1, 2, 6), (1, 6, 5), (2, 3, 7), (2, 7, 6), (3, 0, 4), (3, 4, 7)]
+
+
+def box_vertices(lo, hi):
+    (x0, y0, z0), (x1, y1, z1) = lo, hi
+    return [(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0),
+            (x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)]
+
+
+def write_obj(path, vertices, faces):
+    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in vertices]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in faces]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def write_binary_stl(path, vertices, faces):
+    import struct
+    out = bytearray(b"written by test_mjcf".ljust(80))
+    out += struct.pack("<I", len(faces))
+    for f in faces:
+        out += struct.pack("<3f", 0, 0, 0)
+        for i in f:
+            out += struct.pack("<3f", *vertices[i])
+        out += b"\0\0"
+    path.write_bytes(bytes(out))
+
+
+def prism(polygon, triangles, height):
+    """A polygon (counter-clockwise) with its triangulation, extruded along z."""
+    n = len(polygon)
+    vertices = [(x, y, 0.0) for x, y in polygon] + [(x, y, height) for x, y in polygon]
+    faces = [(a, c, b) for a, b, c in triangles]
+    faces += [(n + a, n + b, n + c) for a, b, c in triangles]
+    for k in range(n):
+        a, b = k, (k + 1) % n
+        faces += [(a, b, n + b), (a, n + b, n + a)]
+    return vertices, faces
+
+
+# A U-shaped channel: not star-shaped about its faces' centroid, so MuJoCo's default
+# (legacy) inertia overcounts its volume, and its hull (convex) is a full block.
+U_POLYGON = [(0, 0), (3, 0), (3, 2), (2, 2), (2, 1), (1, 1), (1, 2), (0, 2)]
+U_TRIANGLES = [(0, 1, 4), (1, 2, 3), (1, 3, 4), (0, 4, 5), (0, 5, 6), (0, 6, 7)]
+
+
+def mesh_model(tmp_path):
+    meshes = tmp_path / "assets"
+    meshes.mkdir()
+    write_obj(meshes / "box.obj", box_vertices((1.0, 2.0, 3.0), (1.4, 2.2, 3.1)), BOX_FACES)
+    tetra = [(0, 0, 0), (0.3, 0, 0), (0, 0.5, 0), (0, 0, 0.7)]
+    write_binary_stl(meshes / "tetra.stl", tetra, [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)])
+    u = prism([(0.1 * x, 0.1 * y) for x, y in U_POLYGON], U_TRIANGLES, 0.05)
+    write_obj(meshes / "u.obj", *u)
+    bodies = []
+    for i, (mesh, extra) in enumerate([
+        ("box", 'pos="0.1 0.2 0.3" euler="10 20 30" density="800"'),
+        ("tetra", 'mass="2" quat="0.9 0.1 0.3 0.2"'),
+        ("u_legacy", ""), ("u_exact", ""), ("u_convex", ""), ("mirrored", 'mass="3"'),
+    ]):
+        bodies.append(
+            f'<body name="{mesh}" pos="{i} 0 1"><freejoint/>'
+            f'<geom type="mesh" mesh="{mesh}" {extra}/></body>'
+        )
+    text = f"""<mujoco><compiler assetdir="assets"/>
+      <asset><mesh file="box.obj" scale="1 2 3"/><mesh file="tetra.stl"/>
+        <mesh name="mirrored" file="box.obj" scale="-1 2 0.5"/>
+        <mesh name="u_legacy" file="u.obj"/><mesh name="u_exact" file="u.obj" inertia="exact"/>
+        <mesh name="u_convex" file="u.obj" inertia="convex" refpos="0.1 0 0" refquat="0.9 0 0.3 0"/>
+      </asset><worldbody>{"".join(bodies)}</worldbody></mujoco>"""
+    path = tmp_path / "meshes.xml"
+    path.write_text(text)
+    return path
+
+
+def test_mesh_bodies_weigh_and_balance_as_in_mujoco(tmp_path):
+    """Mass, centre of mass (body_ipos) and principal moments (body_inertia) of mesh
+    bodies in OBJ and binary STL, in MuJoCo's three mesh inertia modes, and the geom
+    frame at the mesh's centre (MuJoCo's geom_pos, the Rust tests check Tumble's)."""
+    path = mesh_model(tmp_path)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    world = tumble.World.from_mjcf(path)
+    masses = {}
+    for name in ["box", "tetra", "u_legacy", "u_exact", "u_convex", "mirrored"]:
+        i = model.body(name).id
+        body = world.body(name)
+        masses[name] = body.mass
+        # MuJoCo keeps mesh vertices in single precision: 1e-6 relative.
+        assert body.mass == pytest.approx(model.body_mass[i], rel=1e-6), name
+        rot = quat_matrix(body.orientation)
+        ipos = rot.T @ (body.center_of_mass - body.position)
+        assert ipos == pytest.approx(model.body_ipos[i], abs=1e-6), name
+        g = model.body_geomadr[i]
+        assert model.geom_pos[g] == pytest.approx(ipos, abs=1e-6), name
+        moments = np.linalg.eigvalsh(np.asarray(body.inertia))
+        assert moments == pytest.approx(np.sort(model.body_inertia[i]), rel=1e-5), name
+    # The three modes differ on the U: legacy > exact (0.05 · 0.05 m³ of water) < convex.
+    assert masses["u_exact"] == pytest.approx(1000 * 0.05 * 0.05, rel=1e-9)
+    assert masses["u_legacy"] > 1.01 * masses["u_exact"]
+    assert masses["u_convex"] == pytest.approx(1000 * 0.06 * 0.05, rel=1e-9)
+
+
+def quat_matrix(q):
+    x, y, z, w = q
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+def test_a_mesh_pendulum_swings_as_in_mujoco(tmp_path):
+    """A tetrahedron (binary STL) on a hinge whose axis is none of its principal axes:
+    the swing depends on the mesh's mass, centre and full inertia tensor."""
+    tetra = [(0, 0, 0), (0.3, 0, 0), (0, 0.2, 0), (0, 0, 0.4)]
+    write_binary_stl(tmp_path / "tetra.stl", tetra, [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)])
+    path = tmp_path / "mesh_pendulum.xml"
+    path.write_text("""<mujoco><compiler angle="radian"/><option integrator="RK4"/>
+      <asset><mesh file="tetra.stl"/></asset><worldbody>
+        <body name="bob" pos="0 0 1"><joint name="swing" axis="0.2 1 0.1"/>
+          <geom type="mesh" mesh="tetra" pos="0.1 0 -0.3" euler="0.3 0.2 0.1" density="2000"/>
+        </body></worldbody></mujoco>""")
+    # It hangs at about 0.7 rad (its centre is off the hinge's plane): from -0.5 it swings.
+    names, reference = mujoco_run(path, [-0.5])
+    ours = tumble_run(path, names, [-0.5])
+    worst = difference(ours, reference, [True])
+    print(f"mesh pendulum: largest joint difference {worst:.2e} rad over 1 s")
+    assert worst < 1e-2
+    assert np.ptp(reference) > 1.0  # it swings
+
+
+def test_a_spinning_falling_mesh_body_moves_as_in_mujoco(tmp_path):
+    """A free tetrahedron (binary STL, its geom turned and offset in the body) thrown
+    spinning at 8 rad/s about a body axis that is none of its principal axes: torque-free
+    rotation (Euler's equations with the mesh's full tensor) while it falls for 1 s."""
+    tetra = [(0, 0, 0), (0.3, 0, 0), (0, 0.2, 0), (0, 0, 0.4)]
+    write_binary_stl(tmp_path / "tetra.stl", tetra, [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)])
+    path = tmp_path / "spin.xml"
+    path.write_text("""<mujoco><compiler angle="radian"/><option integrator="RK4"/>
+      <asset><mesh file="tetra.stl"/></asset><worldbody>
+        <body name="bob" pos="0 0 1" euler="0.2 0.1 0"><freejoint/>
+          <geom type="mesh" mesh="tetra" pos="0.05 0 -0.1" euler="0.3 0.2 0.1" density="2000"/>
+        </body></worldbody></mujoco>""")
+    model = mujoco.MjModel.from_xml_path(str(path))
+    model.opt.timestep = DT
+    data = mujoco.MjData(model)
+    spin = np.array([1.0, 8.0, 2.0])  # MuJoCo's free qvel: angular velocity in body axes
+    data.qvel[3:6] = spin
+    world = tumble.World.from_mjcf(path)
+    body = world.body("bob")
+    omega = quat_matrix(body.orientation) @ spin
+    body.angular_velocity = omega
+    # MuJoCo's body origin is at rest: the centre moves with omega x (centre - origin).
+    body.velocity = np.cross(omega, body.center_of_mass - body.position)
+    worst = 0.0
+    for k in range(1, int(round(DURATION / DT)) + 1):
+        mujoco.mj_step(model, data)
+        world.step(DT)
+        if k % SAMPLE == 0:
+            w, x, y, z = data.qpos[3:]
+            turn = 2 * np.arccos(min(1.0, abs(np.dot([x, y, z, w], body.orientation))))
+            worst = max(worst, np.abs(body.position - data.qpos[:3]).max(), turn)
+    print(f"spinning mesh: largest difference {worst:.2e} (m or rad) over 1 s")
+    # Measured 9e-8: both integrate the same rigid-body equations at dt = 1e-4 s.
+    assert worst < 1e-4
+
+
+# --- actuators ------------------------------------------------------------------------
+
+ACTUATED = """<mujoco><compiler angle="radian"/><option integrator="RK4"/>
+  <worldbody>
+    <body name="driven" pos="0 0 1"><joint name="motor_joint" axis="0 1 0" damping="0.05"/>
+      <geom type="capsule" fromto="0 0 0 0.4 0 0" size="0.03" mass="0.8"/></body>
+    <body name="held" pos="0 1 1"><joint name="servo_joint" axis="0 1 0"/>
+      <geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.03" mass="1.2"/></body>
+  </worldbody>
+  <actuator>
+    <motor name="motor" joint="motor_joint" gear="2" ctrlrange="-1.5 1.5"/>
+    <position name="servo" joint="servo_joint" kp="40" kv="2"/>
+  </actuator></mujoco>"""
+
+
+def test_actuator_controls_move_joints_as_in_mujoco(tmp_path):
+    """A motor (gear 2, control 3 clamped to 1.5: 3 N·m against a 0.8 kg arm's weight)
+    and a position servo (kp 40, kv 2) sent to 0.5 rad: the same controls in both."""
+    path = tmp_path / "actuated.xml"
+    path.write_text(ACTUATED)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    model.opt.timestep = DT
+    data = mujoco.MjData(model)
+    world = tumble.World.from_mjcf(path)
+    assert world.actuators == ["motor", "servo"]
+    controls = {"motor": 3.0, "servo": 0.5}
+    for name, value in controls.items():
+        data.ctrl[model.actuator(name).id] = value
+        world.set_control(name, value)
+    assert world.control("motor") == 1.5  # clamped to ctrlrange, as MuJoCo does
+    joints = [world.joint("motor_joint"), world.joint("servo_joint")]
+    worst = 0.0
+    for k in range(1, int(round(DURATION / DT)) + 1):
+        mujoco.mj_step(model, data)
+        world.step(DT)
+        if k % SAMPLE == 0:
+            ours = np.array([j.position for j in joints])
+            d = ours - data.qpos[:2]
+            worst = max(worst, np.abs((d + np.pi) % (2 * np.pi) - np.pi).max())
+    print(f"actuated: largest joint difference {worst:.2e} rad over 1 s; qpos {data.qpos}")
+    assert worst < 1e-2
+    assert abs(data.qpos[0]) > 1.0  # the motor turned its arm over the top
+    assert abs(data.qpos[1] - 0.5) < 0.2  # the servo holds near its target, sagging
+
+
+def test_bad_controls_raise_value_error_naming_the_actuator(tmp_path):
+    path = tmp_path / "actuated.xml"
+    path.write_text(ACTUATED)
+    world = tumble.World.from_mjcf(path)
+    with pytest.raises(ValueError, match=r"^actuator 'nope': no such actuator"):
+        world.set_control("nope", 1.0)
+    with pytest.raises(ValueError, match=r"^actuator 'servo': control: must be a finite"):
+        world.set_control("servo", float("nan"))
+    assert world.control("servo") == 0.0  # nothing changed
+    with pytest.raises(ValueError, match=r"^actuator 'x': no such actuator"):
+        tumble.World().set_control("x", 0.0)

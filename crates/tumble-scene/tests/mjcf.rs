@@ -41,6 +41,7 @@ fn write(name: &str, text: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("tumble-mjcf-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(name);
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
     std::fs::write(&path, text).unwrap();
     path
 }
@@ -479,12 +480,12 @@ fn includes_and_their_defaults_are_read() {
 
 #[test]
 fn unsupported_parts_are_warned_once_with_their_line() {
-    let text = "<mujoco>\n<worldbody>\n<body name=\"a\"><joint armature=\"0.1\"/>\n<geom size=\"0.1\"/>\n<geom type=\"mesh\" mesh=\"m\"/>\n<geom type=\"mesh\" mesh=\"n\"/>\n</body>\n</worldbody>\n<tendon/>\n</mujoco>";
+    let text = "<mujoco>\n<worldbody>\n<body name=\"a\"><joint armature=\"0.1\"/>\n<geom size=\"0.1\"/>\n<geom type=\"hfield\" hfield=\"m\"/>\n<geom type=\"hfield\" hfield=\"n\"/>\n</body>\n</worldbody>\n<tendon/>\n</mujoco>";
     let mut world = z_up();
     let m = mjcf::load(write("warn.xml", text), &mut world, &MjcfOptions::default()).unwrap();
     let lines: Vec<String> = m.warnings.iter().map(|w| w.to_string()).collect();
     assert!(
-        lines.contains(&"warn.xml:5: <geom>: mesh geoms: not yet read (skipped)".to_string()),
+        lines.contains(&"warn.xml:5: <geom>: hfield geoms: not yet read (skipped)".to_string()),
         "{lines:?}"
     );
     assert!(
@@ -698,4 +699,285 @@ fn ball_coordinates_map_to_mujocos_quaternion() {
     // And the anchor stays put: the body turned about its origin.
     let p = world.body(m.body("ball").unwrap()).unwrap().position();
     assert!((p - Vec3::new(0.0, 0.0, 1.0)).length() < 1e-6, "{p}");
+}
+
+/// A box of sides `s` with its low corner at `lo`, as OBJ text (quads, split by the reader).
+fn box_obj(lo: Vec3, s: Vec3) -> String {
+    let mut text = String::from("# box\n");
+    for i in 0..8 {
+        let c = |bit: u32, k: usize| lo[k] + s[k] * ((i >> bit) & 1) as Real;
+        text += &format!("v {} {} {}\n", c(0, 0), c(1, 1), c(2, 2));
+    }
+    for q in [
+        "1 3 4 2", "5 6 8 7", "1 2 6 5", "3 7 8 4", "1 5 7 3", "2 4 8 6",
+    ] {
+        text += &format!("f {q}\n");
+    }
+    text
+}
+
+/// The right tetrahedron O, aX, bY, cZ as binary STL (outward triangles).
+fn tetra_stl(a: f32, b: f32, c: f32) -> Vec<u8> {
+    let p = [[0.0, 0.0, 0.0], [a, 0.0, 0.0], [0.0, b, 0.0], [0.0, 0.0, c]];
+    let tris = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+    let mut out = vec![b' '; 80];
+    out.extend_from_slice(&4u32.to_le_bytes());
+    for t in tris {
+        out.extend_from_slice(&[0u8; 12]);
+        for v in t {
+            for x in p[v] {
+                out.extend_from_slice(&(x as f32).to_le_bytes());
+            }
+        }
+        out.extend_from_slice(&[0u8; 2]);
+    }
+    out
+}
+
+/// Tolerance of mesh mass properties: rounding of sums over the mesh's triangles.
+const MESH: Real = if std::mem::size_of::<Real>() == 4 {
+    3e-5
+} else {
+    1e-9
+};
+
+/// Mesh geoms: a scaled, offset box (OBJ, found through `meshdir`) placed with a turn,
+/// and a right tetrahedron (binary STL, given a mass): volume, centre and inertia in
+/// closed form; the compound's child sits at the mesh's centre (MuJoCo's `geom_pos`).
+#[test]
+fn mesh_geoms_have_the_closed_form_mass_centre_and_inertia() {
+    let (lo, s, scale) = (
+        Vec3::new(1.0, 2.0, 3.0),
+        Vec3::new(0.4, 0.2, 0.1),
+        Vec3::new(1.0, 2.0, 3.0),
+    );
+    let dir = write("meshes/box.obj", &box_obj(lo, s))
+        .parent()
+        .unwrap()
+        .to_path_buf();
+    std::fs::write(dir.join("tetra.stl"), tetra_stl(0.3, 0.5, 0.7)).unwrap();
+    let text = r#"<mujoco><compiler meshdir="meshes" angle="radian"/>
+      <asset><mesh file="box.obj" scale="1 2 3"/><mesh name="t" file="tetra.stl"/></asset>
+      <worldbody>
+        <body name="box" pos="0 0 2"><freejoint/>
+          <geom type="mesh" mesh="box" pos="0.1 0.2 0.3" axisangle="0 0 1 0.5" density="800"/></body>
+        <body name="tetra" pos="3 0 2"><freejoint/><geom type="mesh" mesh="t" mass="2"/></body>
+      </worldbody></mujoco>"#;
+    let mut world = z_up();
+    let m = mjcf::load(write("mesh.xml", text), &mut world, &MjcfOptions::default()).unwrap();
+    assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+    let b = world.body(m.body("box").unwrap()).unwrap();
+    let sides = s * scale;
+    let mass = 800.0 * sides.x * sides.y * sides.z;
+    let turn = Quat::from_axis_angle(Vec3::Z, 0.5);
+    let centre = Vec3::new(0.1, 0.2, 0.3) + turn * ((lo + 0.5 * s) * scale);
+    // Exact to rounding of the sums: in f32 the box's vertices, 9 m out, carry 1e-6 m of
+    // rounding against its 0.3 m sides (mass measured 2.4e-6 off).
+    assert!(close(b.mass(), mass, MESH), "{} vs {mass}", b.mass());
+    assert!(
+        (b.local_center_of_mass() - centre).length() < MESH,
+        "{}",
+        b.local_center_of_mass()
+    );
+    let sq = sides * sides;
+    let own = Vec3::new(sq.y + sq.z, sq.x + sq.z, sq.x + sq.y) * (mass / 12.0);
+    let r = Mat3::from_quat(turn);
+    let expected = r * Mat3::from_diagonal(own) * r.transpose();
+    assert!(
+        mat_close(b.inertia_local(), expected, MESH),
+        "{}",
+        b.inertia_local()
+    );
+    let tumble::Shape::Compound(children) = b.shape() else {
+        panic!("a compound: {:?}", b.shape().kind_name());
+    };
+    assert!((children[0].position - centre).length() < MESH);
+    assert_eq!(children[0].shape.kind_name(), "convex_hull");
+    // The tetrahedron: V = abc/6, centre (a, b, c)/4, covariance about the centre
+    // C_ii = m a_i² · 3/80, C_ij = −m a_i a_j / 80; inertia tr(C) 1 − C.
+    let t = world.body(m.body("tetra").unwrap()).unwrap();
+    let e = Vec3::new(0.3, 0.5, 0.7);
+    assert!(close(t.mass(), 2.0, 1e-12));
+    // The STL holds f32 vertices: 1e-7 relative.
+    assert!((t.local_center_of_mass() - e / 4.0).length() < MESH.max(1e-7));
+    let c = Mat3::from_cols(e * e.x, e * e.y, e * e.z) * (-2.0 / 80.0)
+        + Mat3::from_diagonal(e * e) * (2.0 * 4.0 / 80.0);
+    let trace = c.x_axis.x + c.y_axis.y + c.z_axis.z;
+    let expected = Mat3::from_diagonal(Vec3::splat(trace)) - c;
+    assert!(
+        mat_close(t.inertia_local(), expected, MESH.max(1e-6)),
+        "{} vs {expected}",
+        t.inertia_local()
+    );
+}
+
+/// An L-shaped prism (three unit cubes): MuJoCo's three inertia modes. Exact and legacy
+/// (star-shaped about its faces' centroid) give the true volume 3 and centre (5/6, 5/6,
+/// 1/2); convex gives its hull's, volume 3.5.
+#[test]
+fn mesh_inertia_modes_read_a_non_convex_mesh_as_mujoco_does() {
+    let poly = [
+        (0.0, 0.0),
+        (2.0, 0.0),
+        (2.0, 1.0),
+        (1.0, 1.0),
+        (1.0, 2.0),
+        (0.0, 2.0),
+    ];
+    let mut verts = String::new();
+    for z in [0.0, 1.0] {
+        for (x, y) in poly {
+            verts += &format!("{x} {y} {z} ");
+        }
+    }
+    let mut faces = String::new();
+    for k in 1..5 {
+        faces += &format!("0 {} {} 6 {} {} ", k + 1, k, 6 + k, 7 + k);
+    }
+    for k in 0..6 {
+        let (a, b) = (k, (k + 1) % 6);
+        faces += &format!("{a} {b} {} {a} {} {} ", 6 + b, 6 + b, 6 + a);
+    }
+    for (mode, volume, centre) in [
+        ("legacy", 3.0, Vec3::new(5.0 / 6.0, 5.0 / 6.0, 0.5)),
+        ("exact", 3.0, Vec3::new(5.0 / 6.0, 5.0 / 6.0, 0.5)),
+        // The hull: the L plus the triangle (1,1) (2,1) (1,2) of area 1/2, height 1.
+        (
+            "convex",
+            3.5,
+            (Vec3::new(2.5, 2.5, 1.5) + Vec3::new(4.0 / 3.0, 4.0 / 3.0, 0.5) * 0.5) / 3.5,
+        ),
+    ] {
+        let text = format!(
+            r#"<mujoco><asset><mesh name="l" vertex="{verts}" face="{faces}" inertia="{mode}"/></asset>
+            <worldbody><body name="l"><freejoint/><geom type="mesh" mesh="l" density="1"/></body></worldbody></mujoco>"#
+        );
+        let mut world = z_up();
+        let m = mjcf::load(write("l.xml", &text), &mut world, &MjcfOptions::default()).unwrap();
+        let b = world.body(m.body("l").unwrap()).unwrap();
+        assert!(close(b.mass(), volume, EXACT), "{mode}: {}", b.mass());
+        let c = b.local_center_of_mass();
+        assert!((c - centre).length() < 1e-6, "{mode}: {c}");
+    }
+}
+
+/// A mesh welded to the world keeps its triangles (a static mesh body of its own); a
+/// ball dropped on the box's top face comes to rest on it.
+#[test]
+fn a_static_mesh_keeps_its_triangles_and_holds_a_ball() {
+    let dir = write("static/box.obj", &box_obj(Vec3::splat(-0.5), Vec3::ONE))
+        .parent()
+        .unwrap()
+        .to_path_buf();
+    let text = r#"<mujoco><asset><mesh file="box.obj"/></asset><worldbody>
+      <geom type="mesh" mesh="box" pos="0 0 0.5"/>
+      <body name="ball" pos="0.1 0.1 1.5"><freejoint/><geom size="0.1"/></body>
+      </worldbody></mujoco>"#;
+    let path = dir.join("on_mesh.xml");
+    std::fs::write(&path, text).unwrap();
+    let mut world = z_up();
+    let m = mjcf::load(&path, &mut world, &MjcfOptions::default()).unwrap();
+    let kinds: Vec<&str> = world
+        .body_ids()
+        .iter()
+        .map(|id| world.body(*id).unwrap().shape().kind_name())
+        .collect();
+    assert!(kinds.contains(&"trimesh"), "{kinds:?}");
+    for _ in 0..600 {
+        world.step(1.0 / 240.0).unwrap();
+    }
+    let z = world.body(m.body("ball").unwrap()).unwrap().position().z;
+    // At rest on the top face (z = 1) within the contact slop (a few mm).
+    assert!((z - 1.1).abs() < 5e-3, "{z}");
+}
+
+#[test]
+fn bad_meshes_give_one_line_naming_the_element() {
+    let flat = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
+    write("badmesh/flat.obj", flat);
+    let cases = [
+        ("<geom type=\"mesh\" mesh=\"ghost\"/>", "<asset/>", "<geom>: mesh: no mesh asset 'ghost'"),
+        ("<geom type=\"mesh\" mesh=\"gone\"/>", "<asset>\n<mesh file=\"gone.stl\"/></asset>",
+         "<mesh>: file: "),
+        ("<geom type=\"mesh\" mesh=\"flat\"/>", "<asset>\n<mesh file=\"flat.obj\"/></asset>",
+         "<mesh>: mesh has no volume"),
+        ("<geom type=\"mesh\" mesh=\"in\"/>",
+         "<asset>\n<mesh name=\"in\" inertia=\"exact\" vertex=\"0 0 0 1 0 0 0 1 0 0 0 1\" face=\"0 1 2 0 3 1 0 2 3 1 3 2\"/></asset>",
+         "<mesh name=\"in\">: mesh volume is negative"),
+    ];
+    for (geom, asset, expected) in cases {
+        let text = format!(
+            "<mujoco>{asset}<worldbody><body><freejoint/>\n{geom}</body></worldbody></mujoco>"
+        );
+        let path = write("badmesh/bad.xml", &text);
+        let mut world = z_up();
+        let err = mjcf::load(&path, &mut world, &MjcfOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with("bad.xml:") && err.contains(expected),
+            "{err}"
+        );
+        assert!(!err.contains('\n'), "{err}");
+        assert_eq!(world.body_count(), 0);
+    }
+}
+
+/// MJCF files in a scene's `models`: placed and prefixed, their bodies and joints named
+/// as in the file for the scene's joints; the scene's gravity stays (the file's
+/// `<option>` is not read).
+#[test]
+fn a_scene_places_mjcf_models_whose_bodies_its_joints_can_name() {
+    let file = model("cartpole.xml");
+    let file = file.to_str().unwrap();
+    let scene = format!(
+        r#"{{"gravity": [0, 0, -5],
+      "bodies": [{{"name": "ball", "shape": {{"type": "sphere", "radius": 0.1}}, "mass": 1,
+                  "position": [0, 0, 3]}}],
+      "models": [
+        {{"file": "{file}"}},
+        {{"file": "{file}", "prefix": "b_", "position": [3, 0, 0], "orientation": [0, 0, 1, 0]}}],
+      "joints": [{{"type": "fixed", "body": "ball", "other": "b_cart"}}]}}"#
+    );
+    let path = write("mjcf_scene.json", &scene);
+    let s = tumble_scene::load(path.to_str().unwrap()).unwrap();
+    for name in ["ball", "cart", "pole", "b_cart", "b_pole"] {
+        assert!(
+            s.body_names.iter().any(|n| n == name),
+            "{name}: {:?}",
+            s.body_names
+        );
+    }
+    assert_eq!(s.body_names.len(), s.world.body_count());
+    assert_eq!(s.body_colors.len(), s.world.body_count());
+    let w = &s.world;
+    assert_eq!(w.gravity(), Vec3::new(0.0, 0.0, -5.0));
+    // The pole's centre: 0.3 m up its axis, tilted 20° about y, then the model turned
+    // half a turn about z and moved 3 m along x.
+    let a = (20.0 as Real).to_radians();
+    let expected = Vec3::new(3.0 - 0.3 * a.sin(), 0.0, 1.0 + 0.3 * a.cos());
+    let pole = w.body(w.find_body("b_pole").unwrap()).unwrap();
+    assert!(
+        (pole.center_of_mass() - expected).length() < 1e-6,
+        "{}",
+        pole.center_of_mass()
+    );
+    assert!(w.find_joint("b_hinge").is_some() && w.find_joint("hinge").is_some());
+    assert_eq!(w.joints().count(), 5);
+
+    let bad = |models: &str| {
+        let path = write("bad_models.json", &format!(r#"{{"models": [{models}]}}"#));
+        tumble_scene::load(path.to_str().unwrap())
+            .unwrap_err()
+            .to_string()
+    };
+    assert_eq!(
+        bad(&format!(r#"{{"file": "{file}", "fixed_base": true}}"#)),
+        "models[0].fixed_base: not used for MJCF models (the file says which bodies move)"
+    );
+    let missing = bad(r#"{"file": "gone.xml"}"#);
+    assert!(
+        missing.starts_with("models[0]: gone.xml: cannot read"),
+        "{missing}"
+    );
 }

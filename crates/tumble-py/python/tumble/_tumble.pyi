@@ -502,6 +502,13 @@ class World:
     def from_mjcf(path: Union[str, PathLike[str]]) -> World:
         """Loads an MJCF (MuJoCo XML) model: names, joints and gravity from the file;
         what is not read comes out as UserWarnings naming file, line and element."""
+    @property
+    def actuators(self) -> list[str]:
+        """Names of the MJCF model's actuators (from_mjcf), in file order; else empty."""
+    def set_control(self, name: str, value: float) -> None:
+        """Sets MJCF actuator `name`'s control (MuJoCo's ctrl, clamped to ctrlrange)."""
+    def control(self, name: str) -> float:
+        """MJCF actuator `name`'s control as last set (0 until set)."""
     @staticmethod
     def from_urdf(
         path: Union[str, PathLike[str]],

@@ -2,10 +2,13 @@
 //! Tumble bodies and joints. Nothing touches the world until the whole file has been
 //! read, and a failure while creating undoes what was created.
 
+use std::path::Path;
+
 use tumble::{Integrator, JointKind, MassProperties, Quat, Real, Servo, Vec3, World};
 
 use super::frame::{self, vec3, Compiler};
 use super::geom::{self, Geom};
+use super::mesh::{self, Meshes};
 use super::parse::{Defaults, Elem, View, MAIN};
 use super::{ImportedMjcf, MjcfOptions, Warning, Warnings};
 use crate::error::{printable, Result};
@@ -66,6 +69,7 @@ pub(crate) struct Plan {
 struct Ctx<'a> {
     defaults: &'a Defaults,
     compiler: Compiler,
+    meshes: Meshes,
     warn: Warnings,
     bodies: Vec<PlanBody>,
     joints: Vec<PlanJoint>,
@@ -80,11 +84,18 @@ struct Ctx<'a> {
 }
 
 /// Reads the tree and builds it into `world`.
-pub(crate) fn build(root: &Elem, world: &mut World, options: &MjcfOptions) -> Result<ImportedMjcf> {
+/// `dir`: the model file's folder, against which mesh files are found.
+pub(crate) fn build(
+    root: &Elem,
+    dir: &Path,
+    world: &mut World,
+    options: &MjcfOptions,
+) -> Result<ImportedMjcf> {
     let defaults = Defaults::collect(root)?;
     let mut ctx = Ctx {
         defaults: &defaults,
         compiler: Compiler::default(),
+        meshes: Meshes::default(),
         warn: Warnings::default(),
         bodies: Vec::new(),
         joints: Vec::new(),
@@ -98,6 +109,9 @@ pub(crate) fn build(root: &Elem, world: &mut World, options: &MjcfOptions) -> Re
     for c in root.kids("compiler") {
         ctx.compiler.read(&View::new(c, MAIN, &defaults)?)?;
     }
+    let c = &ctx.compiler;
+    let mesh_dir = mesh::mesh_dir(dir, c.meshdir.as_deref(), c.assetdir.as_deref());
+    ctx.meshes = Meshes::collect(root, &defaults, &mesh_dir, c.strip_path, &mut ctx.warn)?;
     let settings = read_options(root, &defaults, &mut ctx.warn)?;
     ctx.limits = settings.limits;
     ctx.passive = settings.passive;
@@ -259,11 +273,6 @@ fn warn_unread_sections(root: &Elem, warn: &mut Warnings) {
             warn.add(kid, &format!("<{}>: not read", kid.tag));
         }
     }
-    for a in root.kids("asset") {
-        if a.kids("mesh").next().is_some() {
-            warn.add(a, "mesh assets: not yet read");
-        }
-    }
 }
 
 /// Composes a child frame onto a parent's.
@@ -291,7 +300,11 @@ fn body_contents(
     let mut geoms = Vec::new();
     for g in elem.kids("geom") {
         let v = View::new(g, class, defaults)?;
-        if let Some(mut gm) = geom::geom(&v, &ctx.compiler, &mut ctx.warn)? {
+        let place = geom::Target {
+            meshes: &mut ctx.meshes,
+            dynamic: ctx.bodies[target].dynamic,
+        };
+        if let Some(mut gm) = geom::geom(&v, &ctx.compiler, place, &mut ctx.warn)? {
             if gm.plane.is_some() && ctx.bodies[target].dynamic {
                 return Err(v.err("type", "a plane must be part of the world body"));
             }

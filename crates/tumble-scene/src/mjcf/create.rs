@@ -6,7 +6,7 @@ use std::collections::BTreeSet;
 
 use tumble::{
     BodyDef, BodyId, BodyKind, CompoundChild, InertiaSpec, JointDef, JointId, JointKind,
-    MassProperties, MassSpec, Quat, Real, Servo, Shape, Vec3, World,
+    MassProperties, MassSpec, Quat, Real, Servo, Shape, TriMesh, Vec3, World,
 };
 
 use super::build::{Plan, PlanBody, PlanJoint, LIGHT};
@@ -29,7 +29,7 @@ struct Made {
 /// Creates the plan in `world`; on an error, removes what it created.
 pub(crate) fn create(plan: Plan, world: &mut World, options: &MjcfOptions) -> Result<ImportedMjcf> {
     let mut made = Made::default();
-    match create_all(&plan, world, &mut made) {
+    match create_all(&plan, world, &mut made, &options.prefix) {
         Ok(ids) => {
             if options.world_settings {
                 world
@@ -58,7 +58,7 @@ struct Ids {
     joints: Vec<JointId>,
 }
 
-fn create_all(plan: &Plan, world: &mut World, made: &mut Made) -> Result<Ids> {
+fn create_all(plan: &Plan, world: &mut World, made: &mut Made, prefix: &str) -> Result<Ids> {
     let filters = if plan.settings.contacts {
         filters(plan)
     } else {
@@ -66,12 +66,13 @@ fn create_all(plan: &Plan, world: &mut World, made: &mut Made) -> Result<Ids> {
     };
     let mut bodies = Vec::with_capacity(plan.bodies.len());
     for (i, b) in plan.bodies.iter().enumerate() {
-        let id = create_body(plan, b, filters[i], world, made)?;
+        let id = create_body(plan, b, filters[i], prefix, world, made)?;
         bodies.push(id);
     }
     let mut joints = Vec::new();
     for (i, j) in plan.joints.iter().enumerate() {
-        let def = joint_def(plan, j, plan.servos[i], &bodies, world)?;
+        let mut def = joint_def(plan, j, plan.servos[i], &bodies, world)?;
+        def.name = Some(format!("{prefix}{}", j.name));
         let id = world
             .create_joint(&def)
             .map_err(|e| SceneError::new(j.label.clone(), e.to_string()))?;
@@ -123,6 +124,7 @@ fn create_body(
     plan: &Plan,
     b: &PlanBody,
     filter: (u32, u32),
+    prefix: &str,
     world: &mut World,
     made: &mut Made,
 ) -> Result<Option<BodyId>> {
@@ -139,7 +141,7 @@ fn create_body(
         })
         .collect();
     let mut def = BodyDef {
-        name: b.name.clone(),
+        name: b.name.as_ref().map(|n| format!("{prefix}{n}")),
         position: b.position,
         orientation: b.orientation,
         collision_group: filter.0,
@@ -152,6 +154,7 @@ fn create_body(
     }
     if !b.dynamic {
         static_planes(b, &def, world, made)?;
+        static_meshes(b, &def, world, made)?;
         if children.is_empty() {
             return Ok(None);
         }
@@ -203,6 +206,38 @@ fn static_planes(b: &PlanBody, def: &BodyDef, world: &mut World, made: &mut Made
         let id = world
             .create_body(&plane_def, Shape::plane(normal, offset))
             .map_err(|e| SceneError::new(b.label.clone(), e.to_string()))?;
+        made.bodies.push(id);
+        made.colors.push((id, g.rgb));
+    }
+    Ok(())
+}
+
+/// A static body's colliding mesh geoms, each a static body of its own with the mesh's
+/// triangles (meshes join no compound).
+fn static_meshes(b: &PlanBody, def: &BodyDef, world: &mut World, made: &mut Made) -> Result<()> {
+    for g in &b.geoms {
+        let Some(mesh) = &g.triangles else {
+            continue;
+        };
+        let vertices = mesh
+            .0
+            .iter()
+            .map(|p| g.position + g.orientation * *p)
+            .collect();
+        let shape = TriMesh::new(vertices, mesh.1.clone())
+            .map(Shape::TriMesh)
+            .map_err(|e| {
+                SceneError::new(g.label.clone(), SceneError::from_engine(e, "").to_string())
+            })?;
+        let mesh_def = BodyDef {
+            name: None,
+            kind: BodyKind::Static,
+            friction: g.friction,
+            ..def.clone()
+        };
+        let id = world
+            .create_body(&mesh_def, shape)
+            .map_err(|e| SceneError::new(g.label.clone(), e.to_string()))?;
         made.bodies.push(id);
         made.colors.push((id, g.rgb));
     }

@@ -30,6 +30,11 @@ pub(crate) struct Compiler {
     pub autolimits: bool,
     /// `settotalmass`: every moving body's mass and inertia scaled to this total (kg).
     pub total_mass: Option<Real>,
+    /// `meshdir` and `assetdir`: where mesh files are, against the model file's folder.
+    pub meshdir: Option<String>,
+    pub assetdir: Option<String>,
+    /// `strippath`: mesh file names lose their folders.
+    pub strip_path: bool,
 }
 
 impl Default for Compiler {
@@ -40,6 +45,9 @@ impl Default for Compiler {
             from_geom: FromGeom::Auto,
             autolimits: true,
             total_mass: None,
+            meshdir: None,
+            assetdir: None,
+            strip_path: false,
         }
     }
 }
@@ -90,6 +98,15 @@ impl Compiler {
         if let Some(m) = v.real("settotalmass")? {
             // MuJoCo: a value <= 0 (its default, -1) leaves the masses as they are.
             self.total_mass = (m > 0.0).then_some(m);
+        }
+        if let Some(d) = v.get("meshdir") {
+            self.meshdir = Some(d.to_string());
+        }
+        if let Some(d) = v.get("assetdir") {
+            self.assetdir = Some(d.to_string());
+        }
+        if let Some(s) = v.flag("strippath")? {
+            self.strip_path = s;
         }
         if v.get("coordinate") == Some("global") {
             return Err(v.err("coordinate", "global coordinates are not supported"));

@@ -6,6 +6,7 @@
 use tumble::{MassProperties, Mat3, Quat, Real, Shape, Vec3};
 
 use super::frame::{self, vec3, Compiler};
+use super::mesh::Meshes;
 use super::parse::View;
 use super::Warnings;
 use crate::error::{printable, Result};
@@ -30,6 +31,10 @@ pub(crate) struct Geom {
     /// The sliding friction coefficient (the first of MuJoCo's three).
     pub friction: Real,
     pub rgb: Option<[u8; 3]>,
+    /// A colliding mesh geom of a static body: its triangles in the geom's frame.
+    pub triangles: Option<super::mesh::Triangles>,
+    /// `file:line: <geom>`, for errors met when the body is created.
+    pub label: String,
 }
 
 /// Geom attributes with physics the import does not map (contact softness, margins,
@@ -50,10 +55,21 @@ fn y_to_z() -> Quat {
     Quat::from_axis_angle(Vec3::X, std::f64::consts::FRAC_PI_2 as Real)
 }
 
+/// Where a geom goes: the file's meshes, and whether its body moves.
+pub(crate) struct Target<'a> {
+    pub meshes: &'a mut Meshes,
+    pub dynamic: bool,
+}
+
 /// A geom, or `None` for the kinds the import does not read (warned about once).
-pub(crate) fn geom(v: &View<'_>, c: &Compiler, warn: &mut Warnings) -> Result<Option<Geom>> {
+pub(crate) fn geom(
+    v: &View<'_>,
+    c: &Compiler,
+    target: Target<'_>,
+    warn: &mut Warnings,
+) -> Result<Option<Geom>> {
     let kind = v.get("type").unwrap_or("sphere");
-    if matches!(kind, "mesh" | "hfield" | "sdf") {
+    if matches!(kind, "hfield" | "sdf") {
         warn.add(v.elem, &format!("{kind} geoms: not yet read (skipped)"));
         return Ok(None);
     }
@@ -61,6 +77,15 @@ pub(crate) fn geom(v: &View<'_>, c: &Compiler, warn: &mut Warnings) -> Result<Op
         if v.get(key).is_some() {
             warn.add(v.elem, &format!("geom {key}: not read"));
         }
+    }
+    if kind == "mesh" {
+        return mesh_geom(v, c, target).map(Some);
+    }
+    if v.get("mesh").is_some() {
+        warn.add(
+            v.elem,
+            &format!("geom mesh on a {kind} geom (a primitive fitted to a mesh): not read, its size used"),
+        );
     }
     let size = v.reals("size", &[])?.unwrap_or_default();
     let (mut position, mut orientation) = frame::frame(v, c)?;
@@ -103,7 +128,41 @@ pub(crate) fn geom(v: &View<'_>, c: &Compiler, warn: &mut Warnings) -> Result<Op
         conaffinity: v.bits("conaffinity", 1)?,
         friction: friction(v)?,
         rgb: rgb(v)?,
+        triangles: None,
+        label: v.elem.label(),
     }))
+}
+
+/// A mesh geom: its frame moved to the mesh's centre of mass (MuJoCo's `geom_pos`); the
+/// mesh's convex hull on a moving body, its triangles on a static one.
+fn mesh_geom(v: &View<'_>, c: &Compiler, target: Target<'_>) -> Result<Geom> {
+    let name = v
+        .get("mesh")
+        .ok_or_else(|| v.err("mesh", "missing on a mesh geom"))?;
+    if v.get("fromto").is_some() {
+        return Err(v.err("fromto", "not allowed on a mesh geom"));
+    }
+    let (position, orientation) = frame::frame(v, c)?;
+    let (contype, conaffinity) = (v.bits("contype", 1)?, v.bits("conaffinity", 1)?);
+    let colliding = contype | conaffinity != 0;
+    let (mesh, hull) = target.meshes.get(v, name, colliding && target.dynamic)?;
+    let position = position + orientation * mesh.center;
+    let triangles = (colliding && !target.dynamic)
+        .then(|| std::rc::Rc::new(super::mesh::nondegenerate(&mesh.points, &mesh.triangles)));
+    let mass = geom_mass(v, &mesh.unit)?.transformed(position, orientation);
+    Ok(Geom {
+        shape: hull,
+        plane: None,
+        position,
+        orientation,
+        mass,
+        contype,
+        conaffinity,
+        friction: friction(v)?,
+        rgb: rgb(v)?,
+        triangles,
+        label: v.elem.label(),
+    })
 }
 
 fn first(v: &View<'_>, size: &[Real]) -> Result<Real> {

@@ -5,6 +5,7 @@
 //!   `<default>` classes and attribute look-up through them;
 //! - `frame.rs`: `<compiler>` and the five ways of giving an orientation;
 //! - `geom.rs`: geoms and `<inertial>` (shapes, mass properties, contact settings);
+//! - `mesh.rs`: `<asset><mesh>` (OBJ and STL files) and mesh geoms' hulls and inertia;
 //! - `build.rs`: the body tree to Tumble bodies and joints, collision filters, actuators.
 //!
 //! What maps to what:
@@ -36,6 +37,7 @@ mod control;
 mod create;
 mod frame;
 mod geom;
+mod mesh;
 mod parse;
 
 use std::path::Path;
@@ -55,6 +57,9 @@ pub struct MjcfOptions {
     /// Whether `<option>` sets the world's gravity and integrator (true when the model
     /// makes the world, false when it is added to a scene).
     pub world_settings: bool,
+    /// Put before every body and joint name in the world (the [`ImportedMjcf`]'s names
+    /// stay the file's), so that one file can be added twice.
+    pub prefix: String,
 }
 
 impl Default for MjcfOptions {
@@ -63,6 +68,7 @@ impl Default for MjcfOptions {
             position: Vec3::ZERO,
             orientation: Quat::IDENTITY,
             world_settings: true,
+            prefix: String::new(),
         }
     }
 }
@@ -178,8 +184,10 @@ pub fn load(
     world: &mut World,
     options: &MjcfOptions,
 ) -> Result<ImportedMjcf> {
-    let root = parse::read(path.as_ref())?;
-    build::build(&root, world, options)
+    let path = path.as_ref();
+    let root = parse::read(path)?;
+    let dir = path.parent().unwrap_or(Path::new(""));
+    build::build(&root, dir, world, options)
 }
 
 /// A scene of one model: a world with the file's gravity (default (0, 0, −9.81): MJCF is

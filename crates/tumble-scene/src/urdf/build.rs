@@ -188,26 +188,54 @@ pub(crate) fn plan(model: &Model, opts: &UrdfOptions) -> Result<Plan> {
         planned.def.orientation = pose[group[0]].rotation;
         bodies.push(planned);
     }
+    let joints = plan_joints(
+        model,
+        &tree,
+        &index,
+        (&host, &offset),
+        opts,
+        &mut bodies,
+        &mut warnings,
+    );
+    let links = model
+        .links
+        .iter()
+        .enumerate()
+        .map(|(i, link)| (link.name.clone(), host[i]))
+        .collect();
+    Ok(Plan {
+        bodies,
+        joints,
+        links,
+        warnings,
+    })
+}
+
+/// Every joint between two bodies (fixed joints merged away are none), parents first.
+/// A planar joint adds two light bodies to `bodies` (see [`planar`]).
+fn plan_joints(
+    model: &Model,
+    tree: &Tree,
+    index: &BTreeMap<&str, usize>,
+    (host, offset): (&[usize], &[Pose]),
+    opts: &UrdfOptions,
+    bodies: &mut Vec<PlannedBody>,
+    warnings: &mut Vec<String>,
+) -> Vec<PlannedJoint> {
     let mut joints = Vec::new();
     for &l in &tree.order[1..] {
         let j = tree.parent_joint[l].expect("every link below the root has a parent joint");
         let joint = &model.joints[j];
         let p = index[joint.parent.as_str()];
-        if host[l] == host[p] {
+        if host[l] == host[p] || joint.kind == JointType::Floating {
             continue;
         }
-        let kind = match joint.kind {
-            JointType::Floating => continue,
-            JointType::Planar => {
-                warnings.push(format!(
-                    "{}: type: planar joints are not supported; the child link moves freely",
-                    joint.at
-                ));
-                continue;
-            }
-            _ => joint_kind(joint),
-        };
         let parent_frame = offset[p].then(&joint.origin);
+        if joint.kind == JointType::Planar {
+            let ends = (host[l], host[p]);
+            joints.extend(planar(joint, ends, &parent_frame, &opts.prefix, bodies));
+            continue;
+        }
         let start = joint
             .limits
             .filter(|[lo, hi]| *lo > 0.0 || *hi < 0.0)
@@ -222,7 +250,7 @@ pub(crate) fn plan(model: &Model, opts: &UrdfOptions) -> Result<Plan> {
             start,
             at: joint.at.clone(),
             name: format!("{}{}", opts.prefix, joint.name),
-            kind,
+            kind: joint_kind(joint),
             body: host[l],
             other: host[p],
             other_anchor: parent_frame.position,
@@ -230,18 +258,100 @@ pub(crate) fn plan(model: &Model, opts: &UrdfOptions) -> Result<Plan> {
             other_axis: parent_frame.rotation * joint.axis,
         });
     }
-    let links = model
-        .links
-        .iter()
-        .enumerate()
-        .map(|(i, link)| (link.name.clone(), host[i]))
-        .collect();
-    Ok(Plan {
-        bodies,
-        joints,
-        links,
-        warnings,
-    })
+    joints
+}
+
+/// A light body's share of the body it carries: 1/1000 of its mass and largest moment.
+const LIGHT: Real = 1e-2;
+
+/// URDF's planar joint (the child moves in the plane normal to the axis and turns about
+/// it): a slider along the joint frame's first in-plane direction (x for an axis along z),
+/// one along the second (n × that) and a hinge about the axis, chained through two light
+/// bodies at the child's frame that collide with nothing. The three are named
+/// `name/x`, `name/y` and `name/theta` (MoveIt's names for a planar joint's variables);
+/// damping and friction act on each.
+fn planar(
+    joint: &super::parse::Joint,
+    (child, parent): (usize, usize),
+    parent_frame: &Pose,
+    prefix: &str,
+    bodies: &mut Vec<PlannedBody>,
+) -> Vec<PlannedJoint> {
+    let n = joint.axis;
+    let u = (Vec3::X - n * n.x)
+        .try_normalize()
+        .unwrap_or_else(|| (Vec3::Y - n * n.y).normalize());
+    let v = n.cross(u);
+    let carried = &bodies[child].def;
+    let mass = match carried.mass {
+        MassSpec::Mass(m) => m,
+        _ => 1.0,
+    };
+    let moment = match carried.inertia {
+        Some(InertiaSpec::Tensor(t)) => tumble::math::symmetric_eigen(t).0.max_element(),
+        _ => mass,
+    };
+    let light = BodyDef {
+        name: None,
+        kind: BodyKind::Dynamic,
+        mass: MassSpec::Mass(LIGHT * mass),
+        center_of_mass: Some(Vec3::ZERO),
+        inertia: Some(InertiaSpec::Tensor(tumble::Mat3::from_diagonal(
+            Vec3::splat(LIGHT * moment),
+        ))),
+        collision_group: 0,
+        collision_mask: 0,
+        ..carried.clone()
+    };
+    let first = bodies.len();
+    for _ in 0..2 {
+        bodies.push(PlannedBody {
+            at: joint.at.clone(),
+            color: None,
+            def: light.clone(),
+            shape: Shape::sphere(NO_SHAPE_RADIUS),
+        });
+    }
+    let drive = joint_kind(&super::parse::Joint {
+        kind: JointType::Prismatic,
+        limits: None,
+        ..joint.clone()
+    });
+    let turn = joint_kind(&super::parse::Joint {
+        kind: JointType::Continuous,
+        limits: None,
+        ..joint.clone()
+    });
+    let links = [
+        ("x", drive, first, parent, u),
+        ("y", drive, first + 1, first, v),
+        ("theta", turn, child, first + 1, n),
+    ];
+    links
+        .into_iter()
+        .map(|(var, kind, body, other, axis)| {
+            let on_parent = other == parent;
+            PlannedJoint {
+                start: None,
+                at: joint.at.clone(),
+                name: format!("{prefix}{}/{var}", joint.name),
+                kind,
+                body,
+                other,
+                other_anchor: if on_parent {
+                    parent_frame.position
+                } else {
+                    Vec3::ZERO
+                },
+                axis,
+                other_axis: if on_parent {
+                    parent_frame.rotation * axis
+                } else {
+                    axis
+                },
+            }
+        })
+        .collect()
 }
 
 /// URDF's joint as the engine's kind: limits as given, `<dynamics damping>` as a pure

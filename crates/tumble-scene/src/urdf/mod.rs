@@ -2,7 +2,8 @@
 //! become bodies (mass, centre of mass and full inertia tensor from `<inertial>`;
 //! `<collision>` boxes, spheres, cylinders and meshes as one shape, meshes as convex
 //! hulls), joints become the engine's hinges (revolute, continuous), sliders (prismatic)
-//! and welds (fixed, unless merged), named as in the file and with URDF's coordinates:
+//! and welds (fixed, unless merged), a planar joint two sliders and a hinge through two
+//! light bodies, named as in the file and with URDF's coordinates:
 //! zero at the pose the file describes, positive about (along) the axis, the child
 //! relative to the parent.
 //!
@@ -71,7 +72,7 @@ pub struct Imported {
     pub created: Vec<BodyId>,
     /// Each created body's colour (its link's first visual material), for pictures.
     pub colors: Vec<Option<[u8; 3]>>,
-    /// What was read but not built as written (a planar joint), one line each.
+    /// What was read but not built as written, one line each.
     pub warnings: Vec<String>,
 }
 
