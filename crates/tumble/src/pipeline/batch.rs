@@ -236,26 +236,44 @@ impl Batch {
     /// batch's bodies. Forces set by [`Batch::set_forces`] are dropped from those worlds
     /// (they are part of the state a snapshot replaces). All or nothing.
     pub fn reset(&mut self, worlds: Option<&[usize]>, snapshot: Option<&[u8]>) -> Result<()> {
+        self.reset_with_states(worlds, snapshot, None)
+    }
+
+    /// [`Batch::reset`], then `states[k]` set in the k-th world chosen, as
+    /// [`Batch::set_states`] sets them; every row is checked against the state reset to
+    /// before any world changes (all or nothing).
+    pub fn reset_with_states(
+        &mut self,
+        worlds: Option<&[usize]>,
+        snapshot: Option<&[u8]>,
+        states: Option<&[BodyStates<'_>]>,
+    ) -> Result<()> {
         let chosen = self.chosen(worlds)?;
-        let bytes = match snapshot {
-            Some(b) => {
-                let probe = World::from_snapshot(b)?;
-                if probe.body_ids() != self.bodies.as_slice() {
-                    return Err(Error::snapshot(format!(
-                        "holds {} bodies, not the {} bodies of the batch's worlds",
-                        probe.body_count(),
-                        self.bodies.len()
-                    )));
-                }
-                b
+        let bytes = snapshot.unwrap_or(&self.initial[..]);
+        let probe = copy_of(bytes)?;
+        if probe.body_ids() != self.bodies.as_slice() {
+            return Err(Error::snapshot(format!(
+                "holds {} bodies, not the {} bodies of the batch's worlds",
+                probe.body_count(),
+                self.bodies.len()
+            )));
+        }
+        if let Some(states) = states {
+            count_states(states.len(), chosen.len())?;
+            for (&i, s) in chosen.iter().zip(states) {
+                probe
+                    .check_states(s)
+                    .map_err(|e| e.within(&world_field(i)))?;
             }
-            None => &self.initial[..],
-        };
-        for &i in &chosen {
-            // Checked above on a world of the same kind (no callbacks, one thread): it
-            // cannot fail here.
+        }
+        for (k, &i) in chosen.iter().enumerate() {
+            // Checked above on a world of the same kind (no callbacks, one thread): none
+            // of these fails.
             self.worlds[i].restore(bytes)?;
             self.applied[i].clear();
+            if let Some(s) = states.map(|s| &s[k]) {
+                self.worlds[i].set_states(s)?;
+            }
         }
         Ok(())
     }
@@ -281,16 +299,7 @@ impl Batch {
         states: &[BodyStates<'_>],
     ) -> Result<()> {
         let chosen = self.chosen(worlds)?;
-        if states.len() != chosen.len() {
-            return Err(Error::invalid(
-                "states",
-                format!(
-                    "expected {} entries (one per world), got {}",
-                    chosen.len(),
-                    states.len()
-                ),
-            ));
-        }
+        count_states(states.len(), chosen.len())?;
         for (&i, s) in chosen.iter().zip(states) {
             self.same_bodies(i)?;
             self.worlds[i]
@@ -312,6 +321,14 @@ fn copy_of(bytes: &[u8]) -> Result<World> {
     });
     w.restore(bytes)?;
     Ok(w)
+}
+
+fn count_states(given: usize, worlds: usize) -> Result<()> {
+    if given != worlds {
+        let reason = format!("expected {worlds} entries (one per world), got {given}");
+        return Err(Error::invalid("states", reason));
+    }
+    Ok(())
 }
 
 fn out_of_range(field: &str, i: usize, w: usize) -> Error {
