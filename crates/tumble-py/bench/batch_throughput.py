@@ -10,6 +10,10 @@ Cases:
 - 64 ragdolls (the built-in `ragdoll` scene: eleven bodies, limited ball joints and
   hinges, tumbling down a flight of stairs: contacts on jointed bodies), 300 steps.
 
+The cart-poles run twice in Tumble: with its default solver (4 substeps a step, what
+every figure of the README uses) and with 1 substep (`"substeps": 1`, closer to MuJoCo's
+one solve per step; the joints are then softer).
+
 MuJoCo runs the same cart-pole as MJCF (the same masses, box sizes, dt and gravity; its
 geoms collide with nothing) through mujoco.rollout.Rollout (a persistent thread pool of
 `nthread` threads; nthread = 0 steps on the calling thread) with zero control.
@@ -53,6 +57,8 @@ CART_POLE = {
         },
     ],
 }
+
+CART_POLE_1 = dict(CART_POLE, substeps=1)
 
 CART_POLE_MJCF = """
 <mujoco model="cart_pole">
@@ -147,6 +153,9 @@ def main():
         rec = tumble_case(CART_POLE, w, n, threads, args.repeat, record=True)
         mj = mujoco_case(w, n, threads, args.repeat)
         rows.append((f"{w} cart-poles", threads, step, rec, mj))
+        step = tumble_case(CART_POLE_1, w, n, threads, args.repeat, record=False)
+        rec = tumble_case(CART_POLE_1, w, n, threads, args.repeat, record=True)
+        rows.append((f"{w} cart-poles, 1 substep", threads, step, rec, mj))
         w, n = ragdoll
         step = tumble_case("ragdoll", w, n, threads, args.repeat, record=False)
         rec = tumble_case("ragdoll", w, n, threads, args.repeat, record=True)

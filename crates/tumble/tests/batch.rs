@@ -398,14 +398,20 @@ fn bad_input_is_refused_naming_the_field_and_changes_nothing() {
 fn a_failing_world_is_named_and_the_others_finish() {
     // World 1 is sent past the speed limit by a huge force; its step is undone and it
     // stays at its last good step while worlds 0 and 2 finish all of theirs.
-    let mut batch = floating_batch(1.0, 0.1);
-    let mut forces = vec![Vec3::ZERO; 4];
-    forces[1] = Vec3::new(1e9, 0.0, 0.0);
-    batch.set_forces(&forces, None).unwrap();
-    let e = batch.step(0.01, 20).unwrap_err();
-    assert_eq!(e.world, 1);
-    assert!(e.error.is_step_failure());
-    assert!(e.to_string().starts_with("worlds[1]: step "), "{e}");
-    assert_eq!(batch.world(0).unwrap().step_count(), 20);
-    assert!(batch.world(1).unwrap().step_count() < 20);
+    for threads in [1, 2] {
+        let mut batch = floating_batch(1.0, 0.1);
+        batch.set_threads(threads).unwrap();
+        let mut forces = vec![Vec3::ZERO; 4];
+        forces[1] = Vec3::new(1e9, 0.0, 0.0);
+        forces[2] = Vec3::new(1e9, 0.0, 0.0);
+        batch.set_forces(&forces, None).unwrap();
+        let e = batch.step(0.01, 20).unwrap_err();
+        assert_eq!(e.world, 1, "the lowest failing world reports");
+        assert!(e.error.is_step_failure());
+        assert!(e.to_string().starts_with("worlds[1]: step "), "{e}");
+        for (i, w) in batch.worlds().iter().enumerate() {
+            let done = w.step_count() == 20;
+            assert_eq!(done, i == 0 || i == 3, "world {i}, {threads} threads");
+        }
+    }
 }

@@ -189,18 +189,21 @@ impl Batch {
                 .err()
                 .map(|error| StepFailure { world: i, error })
         };
+        // Every world runs all its steps, whichever fails (no short-circuit: which worlds
+        // had stepped when another failed would depend on order or timing); the lowest
+        // index reports.
+        let serial = |worlds: &mut Vec<World>| {
+            let failures: Vec<StepFailure> =
+                worlds.iter_mut().enumerate().filter_map(run).collect();
+            failures.into_iter().next()
+        };
         if self.threads == 1 || self.worlds.len() == 1 {
-            return match self.worlds.iter_mut().enumerate().find_map(run) {
-                Some(f) => Err(f),
-                None => Ok(()),
-            };
+            return serial(&mut self.worlds).map_or(Ok(()), Err);
         }
         if self.pool.is_none() {
             self.pool = crate::threads::shared_pool(self.threads);
         }
         let worlds = &mut self.worlds;
-        // Every world runs all its steps (no short-circuit: which worlds had stepped when
-        // another failed would depend on the threads' timing); the lowest index reports.
         let failures = |worlds: &mut Vec<World>| -> Option<StepFailure> {
             worlds
                 .par_iter_mut()
@@ -210,7 +213,7 @@ impl Batch {
         };
         let failure = match &self.pool {
             Some(pool) => pool.install(|| failures(worlds)),
-            None => worlds.iter_mut().enumerate().filter_map(run).next(),
+            None => serial(worlds),
         };
         failure.map_or(Ok(()), Err)
     }
@@ -367,9 +370,9 @@ impl Batch {
             self.same_bodies(i)?;
         }
         let torque = |r: usize| torques.map_or(Vec3::ZERO, |t| t[r]);
-        for r in 0..rows {
+        for (r, &force) in forces.iter().enumerate() {
             let row = |name: &str| format!("worlds[{}].{name}[{}]", r / n, r % n);
-            check::vec3(&row("forces"), forces[r])?;
+            check::vec3(&row("forces"), force)?;
             check::vec3(&row("torques"), torque(r))?;
         }
         self.clear_forces();
