@@ -62,20 +62,19 @@ impl PyBatch {
     }
 }
 
-/// The batch's world from a Python scene argument: its world, `dt` and `duration`.
-fn scene_world(obj: &Bound<'_, PyAny>) -> PyResult<(World, Real, Real)> {
+/// The batch of `copies` copies of a Python scene argument, with the scene's `dt` and
+/// `duration`. A World is copied as it is, under its lock (so the engine sees its
+/// callbacks and contact hooks, and refuses them); the caller keeps it.
+fn batch_of(
+    obj: &Bound<'_, PyAny>,
+    copies: usize,
+    threads: Option<usize>,
+) -> PyResult<(Batch, Real, Real)> {
     let py = obj.py();
     let loaded = if let Ok(w) = obj.cast::<PyWorld>() {
         let g: MutexGuard<'_, Inner> = w.get().lock()?;
-        if g.callbacks.is_some() {
-            return Err(invalid(
-                "scene",
-                "the world has force callbacks, which are code and cannot be copied",
-            ));
-        }
-        // The world stays the caller's: the batch copies it through a snapshot.
-        let world = World::from_snapshot(&g.world.snapshot()).map_err(engine)?;
-        return Ok((world, g.dt, g.duration));
+        let batch = Batch::new(&g.world, copies, threads).map_err(engine)?;
+        return Ok((batch, g.dt, g.duration));
     } else if obj.is_instance_of::<PyDict>() {
         let json = py.import(intern!(py, "json"))?;
         let text: String = json.call_method1("dumps", (obj,))?.extract()?;
@@ -92,7 +91,22 @@ fn scene_world(obj: &Bound<'_, PyAny>) -> PyResult<(World, Real, Real)> {
         ));
     };
     let s = loaded.map_err(scene)?;
-    Ok((s.world, s.dt, s.duration))
+    let batch = Batch::new(&s.world, copies, threads).map_err(engine)?;
+    Ok((batch, s.dt, s.duration))
+}
+
+/// A world's index from Python, refused past the batch's last.
+fn index(obj: &Bound<'_, PyAny>, worlds: usize) -> PyResult<usize> {
+    let i = whole(obj, "world")?;
+    usize::try_from(i)
+        .ok()
+        .filter(|&i| i < worlds)
+        .ok_or_else(|| {
+            invalid(
+                "world",
+                format!("index {i} out of range for a batch of {worlds} worlds"),
+            )
+        })
 }
 
 /// An int argument (not a bool, not a float), as Python's `operator.index` takes it.
@@ -374,22 +388,25 @@ impl PyBatch {
             return Err(invalid("copies", format!("must be >= 1, got {copies}")));
         }
         let threads = thread_count(threads)?;
-        let (world, dt, duration) = scene_world(scene)?;
         let copies = usize::try_from(copies).map_err(|_| invalid("copies", "too many"))?;
-        let batch = Batch::new(&world, copies, threads).map_err(engine)?;
+        let (batch, dt, duration) = batch_of(scene, copies, threads)?;
+        // Every copy starts as world 0 does.
+        let world = batch.world(0).map_err(engine)?;
         let bodies = || world.bodies().map(|(_, b)| b);
         let start = [
             bodies().map(|b| b.position()).collect(),
             bodies().map(|b| b.linear_velocity()).collect(),
             bodies().map(|b| b.angular_velocity()).collect(),
         ];
+        let names = bodies().map(|b| b.name().map(str::to_string)).collect();
+        let dynamic = bodies().map(|b| b.kind() == BodyKind::Dynamic).collect();
         Ok(PyBatch {
             inner: Mutex::new(BatchInner {
                 batch,
                 dt,
                 duration,
-                names: bodies().map(|b| b.name().map(str::to_string)).collect(),
-                dynamic: bodies().map(|b| b.kind() == BodyKind::Dynamic).collect(),
+                names,
+                dynamic,
                 start,
             }),
         })
@@ -744,15 +761,21 @@ impl PyBatch {
     }
 
     /// World `i`'s whole state as bytes (as `World.snapshot`).
-    fn snapshot<'py>(&self, py: Python<'py>, i: usize) -> PyResult<Bound<'py, PyBytes>> {
+    fn snapshot<'py>(
+        &self,
+        py: Python<'py>,
+        i: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyBytes>> {
         let g = self.lock()?;
+        let i = index(i, g.batch.len())?;
         let bytes = g.batch.world(i).map_err(engine)?.snapshot();
         Ok(PyBytes::new(py, &bytes))
     }
 
     /// A new tumble.World continuing world `i` (a copy: changing it leaves the batch).
-    fn world(&self, i: usize) -> PyResult<PyWorld> {
+    fn world(&self, i: &Bound<'_, PyAny>) -> PyResult<PyWorld> {
         let g = self.lock()?;
+        let i = index(i, g.batch.len())?;
         let bytes = g.batch.world(i).map_err(engine)?.snapshot();
         Ok(PyWorld::new_inner(Inner {
             world: World::from_snapshot(&bytes).map_err(engine)?,

@@ -281,6 +281,7 @@ def test_bad_input_is_refused_naming_the_field_and_changes_nothing():
         (TypeError, "steps: expected an int", lambda: batch.step(steps=1.5)),
         (ValueError, "every: must be >= 1", lambda: batch.simulate(steps=3, every=0)),
         (ValueError, "world: index 5 out of range", lambda: batch.world(5)),
+        (ValueError, "world: index -1 out of range", lambda: batch.snapshot(-1)),
         (TypeError, "rng: expected a numpy.random.Generator", lambda: batch.randomize(7)),
         (ValueError, "velocities: must be a finite number >= 0", lambda: batch.randomize(np.random.default_rng(), velocities=-1.0)),
     ]
@@ -314,3 +315,25 @@ def test_a_world_with_a_callback_is_refused_and_a_failed_world_is_named():
     assert e.value.trajectory.position.shape[1:] == (3, 1, 3)
     counts = batch.step_counts
     assert counts[0] == counts[2] and counts[1] < counts[0]
+
+
+def test_step_releases_the_interpreter():
+    # Another Python thread runs while the batch steps: if the interpreter's lock were
+    # held for the call, the loop below could not count during it.
+    import threading
+
+    batch = tumble.Batch("ragdoll", copies=4, threads=1)
+    done = threading.Event()
+
+    def run():
+        batch.step(steps=300)
+        done.set()
+
+    thread = threading.Thread(target=run)
+    thread.start()
+    count = 0
+    while not done.is_set():
+        count += 1
+    thread.join()
+    assert count > 1000
+    assert batch.step_counts == [300] * 4
