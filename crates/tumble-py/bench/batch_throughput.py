@@ -8,7 +8,10 @@ Cases:
   y; no contacts; dt = 0.01 s, gravity 9.81 m/s² along -z), 500 steps, each world's cart
   and pole kicked by a different small velocity so that the poles fall and swing;
 - 64 ragdolls (the built-in `ragdoll` scene: eleven bodies, limited ball joints and
-  hinges, tumbling down a flight of stairs: contacts on jointed bodies), 300 steps.
+  hinges, tumbling down a flight of stairs: contacts on jointed bodies), 300 steps, each
+  as the scene starts (kicked by as little as 0.01 m/s per body, some ragdolls fail near
+  0.85 s with an arm spinning past max_angular_speed, alone as in a batch: an engine
+  issue reported with this benchmark, not the batch's).
 
 The cart-poles run twice in Tumble: with its default solver (4 substeps a step, what
 every figure of the README uses) and with 1 substep (`"substeps": 1`, closer to MuJoCo's
@@ -90,10 +93,11 @@ def best(fn, repeat):
     return min(times)
 
 
-def tumble_case(scene, copies, steps, threads, repeat, record):
+def tumble_case(scene, copies, steps, threads, repeat, record, kick=0.05):
     def setup():
         batch = tumble.Batch(scene, copies=copies, threads=threads)
-        batch.randomize(np.random.default_rng(1), velocities=0.05)
+        if kick:
+            batch.randomize(np.random.default_rng(1), velocities=kick)
         if record:
             return lambda: batch.simulate(steps=steps, every=1)
         return lambda: batch.step(steps=steps)
@@ -157,8 +161,9 @@ def main():
         rec = tumble_case(CART_POLE_1, w, n, threads, args.repeat, record=True)
         rows.append((f"{w} cart-poles, 1 substep", threads, step, rec, mj))
         w, n = ragdoll
-        step = tumble_case("ragdoll", w, n, threads, args.repeat, record=False)
-        rec = tumble_case("ragdoll", w, n, threads, args.repeat, record=True)
+        # The ragdolls start as the scene does (see the note on kicks in the README).
+        step = tumble_case("ragdoll", w, n, threads, args.repeat, record=False, kick=0)
+        rec = tumble_case("ragdoll", w, n, threads, args.repeat, record=True, kick=0)
         rows.append((f"{w} ragdolls", threads, step, rec, None))
     print()
     head = ("case", "threads", "tumble step", "tumble simulate", "mujoco rollout", "simulate / rollout")
