@@ -8,6 +8,7 @@
 //! The Python-facing names, signatures and docstrings are mirrored in
 //! `python/tumble/_tumble.pyi`; keep the two in step.
 
+mod batch;
 mod body;
 mod bulk;
 mod callbacks;
@@ -54,5 +55,6 @@ fn tumble_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     character::register(m)?;
     callbacks::register(m)?;
     models::register(m)?;
+    batch::register(m)?;
     Ok(())
 }

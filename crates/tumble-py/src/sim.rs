@@ -60,6 +60,33 @@ impl Trajectory {
     }
 }
 
+impl Trajectory {
+    /// A batch's recording (`batch.rs`): `data` is time (T,) and position, orientation,
+    /// velocity, angular velocity, each shaped `lead` (T, W, N) and then 3 or 4.
+    pub(crate) fn of_frames(
+        py: Python<'_>,
+        data: [Vec<f64>; 5],
+        lead: &[usize],
+        names: Vec<Option<String>>,
+    ) -> PyResult<Trajectory> {
+        let [time, position, orientation, velocity, angular_velocity] = data;
+        let shape = |width: usize| [lead, &[width]].concat();
+        Ok(Trajectory {
+            time: array(py, time, &lead[..1])?,
+            position: array(py, position, &shape(3))?,
+            orientation: array(py, orientation, &shape(4))?,
+            velocity: array(py, velocity, &shape(3))?,
+            angular_velocity: array(py, angular_velocity, &shape(3))?,
+            kinetic: None,
+            potential: None,
+            total: None,
+            linear_momentum: None,
+            angular_momentum: None,
+            names,
+        })
+    }
+}
+
 /// What a run records, in flat f64 buffers.
 #[derive(Default)]
 struct Recording {
@@ -129,7 +156,7 @@ impl Recording {
 
 /// The frames a run of `steps` records with `every`: step 0, every `every`-th step, the
 /// last.
-fn frame_count(steps: u64, every: u64) -> u64 {
+pub(crate) fn frame_count(steps: u64, every: u64) -> u64 {
     steps / every + 1 + u64::from(steps % every != 0)
 }
 
@@ -169,7 +196,7 @@ fn size(bytes: u128) -> String {
 /// Reserving it would abort the interpreter (Rust aborts when an allocation fails) or,
 /// under overcommit, succeed and end in the out-of-memory killer far into the run.
 /// `field` is the argument that asked for the run (`steps` or `duration`).
-fn check_fits(
+pub(crate) fn check_fits(
     py: Python<'_>,
     field: &str,
     frames: u64,

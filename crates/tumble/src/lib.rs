@@ -30,8 +30,9 @@ pub mod threads;
 pub use collision::{broad_phase, geometry, narrow_phase, query, shape};
 pub use dynamics::{body, force, integrate, joint, solver};
 pub use pipeline::world::query as world_query;
-pub use pipeline::{analysis, character, contact_cache, diagnostics, hooks, sensors, world};
+pub use pipeline::{analysis, batch, character, contact_cache, diagnostics, hooks, sensors, world};
 
+pub use batch::{Batch, JointTarget, StepFailure};
 pub use body::{Body, BodyDef, BodyKind, InertiaSpec, MassSpec};
 pub use character::{CharacterController, CharacterDef, Ground, Push};
 pub use collision::contact::{Contact, ContactEvent, ContactEventKind};

@@ -118,7 +118,7 @@ impl Workers {
 }
 
 /// The pool of `threads` threads that other worlds use, or a new one.
-fn shared_pool(threads: usize) -> Option<Arc<rayon::ThreadPool>> {
+pub(crate) fn shared_pool(threads: usize) -> Option<Arc<rayon::ThreadPool>> {
     let mut pools = POOLS.lock().unwrap_or_else(|p| p.into_inner());
     pools.retain(|(_, weak)| weak.strong_count() > 0);
     if let Some(pool) = pools

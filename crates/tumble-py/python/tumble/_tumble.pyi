@@ -38,6 +38,8 @@ class SimulationError(RuntimeError):
     """``is not finite``, or the speed reached against the limit."""
     trajectory: Optional[Trajectory]
     """From ``simulate``: the run recorded up to the last good step; otherwise None."""
+    world: int
+    """From a Batch only: the index of the world whose step failed."""
 
 class Shape:
     """A collision shape; make one with a subclass. Immutable, shareable between bodies."""
@@ -815,6 +817,106 @@ class World:
     def __reduce__(self) -> tuple[object, tuple[bytes, float, float]]: ...
     def __copy__(self) -> World: ...
     def __deepcopy__(self, memo: object) -> World: ...
+
+class Batch:
+    """W independent copies of a world stepped together across threads (issue 20).
+
+    ``Batch(scene, copies, threads=None)``: ``scene`` a World (copied as it is now), a scene
+    dict, a scene or model file's path or a built-in scene's name; ``copies`` W, an int
+    >= 1; ``threads`` how many threads step the worlds (default TUMBLE_THREADS, else every
+    core). Each world steps on one thread, so it is bit-identical to the same world stepped
+    alone, whatever ``threads``. A World with force callbacks or a contact filter or
+    modifier is refused. Arrays are float64, shaped (W, N, 3) or (W, N, 4); settable ones are
+    checked whole (``worlds[1].velocities[0]: ...``) before any world changes, and wake the
+    bodies."""
+
+    def __init__(
+        self,
+        scene: Union[World, dict[str, Any], str, PathLike[str]],
+        copies: int,
+        threads: Optional[int] = None,
+    ) -> None: ...
+    def __len__(self) -> int: ...
+    copies: int
+    """W, the number of worlds."""
+    threads: int
+    """Threads stepping the worlds (1 to 256); assignable."""
+    body_names: list[Optional[str]]
+    """The bodies' names along the arrays' second axis."""
+    def body_index(self, name: str) -> int:
+        """The index along the body axis of the body called name (KeyError if none)."""
+    dt: float
+    """The default step (s): the scene's dt, else 0.01."""
+    time: F64Array
+    """Each world's time (s), (W,)."""
+    step_counts: list[int]
+    """Each world's steps taken."""
+    positions: F64Array
+    """(W, N, 3) body frame origins (m); assignable."""
+    orientations: F64Array
+    """(W, N, 4) quaternions [x, y, z, w]; assignable."""
+    velocities: F64Array
+    """(W, N, 3) centre-of-mass velocities (m/s); assignable."""
+    angular_velocities: F64Array
+    """(W, N, 3) angular velocities (rad/s, world frame); assignable."""
+    def step(self, dt: Optional[float] = None, steps: int = 1) -> None:
+        """Steps every world ``steps`` times by dt (default the scene's), the interpreter's
+        lock released. A world whose step fails stays at its last good step while the
+        others finish; SimulationError names it (``worlds[3]: step 41 ...``, ``.world``)."""
+    def apply_forces(self, forces: npt.ArrayLike, torques: Optional[npt.ArrayLike] = None) -> None:
+        """Constant forces (N, at each centre of mass) and torques (N·m), (W, N, 3), acting
+        from now on at every step until the next apply_forces or clear_forces (they persist,
+        as World.add_force's do). Resetting a world drops its forces."""
+    def clear_forces(self) -> None:
+        """Removes the forces of apply_forces from every world."""
+    def set_joint_targets(
+        self,
+        name: str,
+        values: npt.ArrayLike,
+        *,
+        kind: Optional[Literal["velocity", "position"]] = None,
+    ) -> None:
+        """The target of joint ``name`` in each world, values (W,): its motor's speed
+        ("velocity") or its servo's target ("position"); by default what the joint has."""
+    def reset(
+        self,
+        worlds: Optional[Sequence[int]] = None,
+        snapshot: Optional[bytes] = None,
+        *,
+        positions: Optional[npt.ArrayLike] = None,
+        orientations: Optional[npt.ArrayLike] = None,
+        velocities: Optional[npt.ArrayLike] = None,
+        angular_velocities: Optional[npt.ArrayLike] = None,
+    ) -> None:
+        """Returns the worlds listed (default all, K of them) to the initial state or to a
+        snapshot's, then sets any (K, N, 3|4) arrays given. All or nothing."""
+    def randomize(
+        self,
+        rng: np.random.Generator,
+        *,
+        worlds: Optional[Sequence[int]] = None,
+        positions: float = 0.0,
+        velocities: float = 0.0,
+        angular_velocities: float = 0.0,
+    ) -> None:
+        """Resets worlds to the initial state with every dynamic body's position, velocity
+        and angular velocity moved by uniform noise in [-s, s] per component, drawn from
+        rng (reproducible for a seeded Generator)."""
+    def snapshot(self, i: int) -> bytes:
+        """World i's state as bytes (as World.snapshot)."""
+    def world(self, i: int) -> World:
+        """A new World continuing world i (a copy)."""
+    def simulate(
+        self,
+        duration: Optional[float] = None,
+        dt: Optional[float] = None,
+        *,
+        steps: Optional[int] = None,
+        every: int = 1,
+    ) -> Trajectory:
+        """Runs every world as World.simulate does; the Trajectory's arrays have a world
+        axis: position (T, W, N, 3), orientation (T, W, N, 4), velocity and
+        angular_velocity (T, W, N, 3), time (T,)."""
 
 class Push:
     """An impulse a character's move gave a dynamic body in its way."""

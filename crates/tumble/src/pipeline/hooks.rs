@@ -205,6 +205,11 @@ pub(crate) struct Hooks {
 }
 
 impl Hooks {
+    /// Whether a contact filter or modifier (code, which snapshots do not keep) is set.
+    pub fn has_code(&self) -> bool {
+        self.filter.is_some() || self.modifier.is_some()
+    }
+
     pub fn set_filter(&mut self, filter: Option<ContactFilter>) {
         self.filter = filter;
         self.verdicts = Verdicts::default();

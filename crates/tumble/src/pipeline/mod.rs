@@ -14,10 +14,13 @@
 //! character/     the character controller: a kinematic capsule that slides, climbs
 //!                slopes and steps, snaps to the ground and pushes bodies, over `&World`
 //! diagnostics    energies, momenta, state hash
+//! batch          W copies of a world stepped together on a thread pool (worlds as the
+//!                unit of parallelism), with per-world resets, states, forces, joint targets
 //! analysis       convergence order, energy behaviour, stability of the integrators
 //! ```
 
 pub mod analysis;
+pub mod batch;
 pub(crate) mod ccd;
 pub mod character;
 pub mod contact_cache;

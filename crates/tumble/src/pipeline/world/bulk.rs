@@ -81,7 +81,7 @@ impl World {
 
     /// Every row of `states` against what its single setter accepts, in the order
     /// `set_states` applies them (so the error is the first the setters would meet).
-    fn check_states(&self, states: &BodyStates<'_>) -> Result<()> {
+    pub(crate) fn check_states(&self, states: &BodyStates<'_>) -> Result<()> {
         let n = self.body_count();
         let limits = self.settings.limits;
         for (i, &p) in rows("positions", states.positions, n)?.iter().enumerate() {

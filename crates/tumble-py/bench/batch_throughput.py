@@ -1,0 +1,183 @@
+"""World-steps per second of tumble.Batch against MuJoCo's own batched stepping,
+mujoco.rollout, on 1 and 2 threads (issue 20). Not run by CI: run it on a quiet machine.
+
+    target/venv/bin/python crates/tumble-py/bench/batch_throughput.py [--quick]
+
+Cases:
+- 1,024 cart-poles (a 1 kg cart on a slider along x, a 0.1 kg, 1 m pole on a hinge about
+  y; no contacts; dt = 0.01 s, gravity 9.81 m/s² along -z), 500 steps, each world's cart
+  and pole kicked by a different small velocity so that the poles fall and swing;
+- 64 ragdolls (the built-in `ragdoll` scene: eleven bodies, limited ball joints and
+  hinges, tumbling down a flight of stairs: contacts on jointed bodies), 300 steps, each
+  as the scene starts (kicked by as little as 0.01 m/s per body, some ragdolls fail near
+  0.85 s with an arm spinning past max_angular_speed, alone as in a batch: an engine
+  issue reported with this benchmark, not the batch's).
+
+The cart-poles run twice in Tumble: with its default solver (4 substeps a step, what
+every figure of the README uses) and with 1 substep (`"substeps": 1`, closer to MuJoCo's
+one solve per step; the joints are then softer).
+
+MuJoCo runs the same cart-pole as MJCF (the same masses, box sizes, dt and gravity; its
+geoms collide with nothing) through mujoco.rollout.Rollout (a persistent thread pool of
+`nthread` threads; nthread = 0 steps on the calling thread) with zero control.
+rollout writes every step's state into its output array, so Tumble is timed both ways:
+`step` (nothing recorded) and `simulate(every=1)` (every step's positions, orientations,
+velocities and angular velocities recorded). The figures are the best of `--repeat`
+runs (default 3), as world-steps per second = W × steps / seconds.
+"""
+
+import argparse
+import json
+import os
+import time
+
+import numpy as np
+
+import tumble
+
+CART_POLE = {
+    "gravity": [0, 0, -9.81],
+    "dt": 0.01,
+    "sleep": False,
+    "bodies": [
+        {"name": "cart", "shape": {"type": "box", "half_extents": [0.2, 0.1, 0.05]}, "mass": 1.0},
+        {
+            "name": "pole",
+            "shape": {"type": "box", "half_extents": [0.02, 0.02, 0.5]},
+            "mass": 0.1,
+            "position": [0, 0, 0.5],
+        },
+    ],
+    "joints": [
+        {"type": "slider", "name": "track", "body": "cart", "axis": [1, 0, 0]},
+        {
+            "type": "hinge",
+            "name": "pivot",
+            "body": "pole",
+            "other": "cart",
+            "anchor": [0, 0, -0.5],
+            "axis": [0, 1, 0],
+        },
+    ],
+}
+
+CART_POLE_1 = dict(CART_POLE, substeps=1)
+
+CART_POLE_MJCF = """
+<mujoco model="cart_pole">
+  <option timestep="0.01" gravity="0 0 -9.81"/>
+  <worldbody>
+    <body name="cart">
+      <joint name="track" type="slide" axis="1 0 0"/>
+      <geom type="box" size="0.2 0.1 0.05" mass="1.0" contype="0" conaffinity="0"/>
+      <body name="pole">
+        <joint name="pivot" type="hinge" axis="0 1 0"/>
+        <geom type="box" size="0.02 0.02 0.5" pos="0 0 0.5" mass="0.1"
+              contype="0" conaffinity="0"/>
+      </body>
+    </body>
+  </worldbody>
+  <actuator><motor joint="track"/></actuator>
+</mujoco>
+"""
+
+
+def best(fn, repeat):
+    """The shortest of `repeat` timed calls of fn() (each after an untimed setup)."""
+    times = []
+    for _ in range(repeat):
+        run = fn()
+        t0 = time.perf_counter()
+        run()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def tumble_case(scene, copies, steps, threads, repeat, record, kick=0.05):
+    def setup():
+        batch = tumble.Batch(scene, copies=copies, threads=threads)
+        if kick:
+            batch.randomize(np.random.default_rng(1), velocities=kick)
+        if record:
+            return lambda: batch.simulate(steps=steps, every=1)
+        return lambda: batch.step(steps=steps)
+
+    return copies * steps / best(setup, repeat)
+
+
+def mujoco_case(copies, steps, threads, repeat):
+    import mujoco
+    from mujoco import rollout
+
+    model = mujoco.MjModel.from_xml_string(CART_POLE_MJCF)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    data = mujoco.MjData(model)
+    size = mujoco.mj_stateSize(model, spec)
+    rng = np.random.default_rng(1)
+    initial = np.zeros((copies, size))
+    for i in range(copies):
+        mujoco.mj_resetData(model, data)
+        data.qvel[:] = rng.uniform(-0.05, 0.05, model.nv)
+        mujoco.mj_getState(model, data, initial[i], spec)
+    control = np.zeros((copies, steps, model.nu))
+    state = np.empty((copies, steps, size))
+    sensordata = np.empty((copies, steps, model.nsensordata))
+    datas = [mujoco.MjData(model) for _ in range(max(threads, 1))]
+    # nthread = 0: the calling thread steps every world (MuJoCo's own 1-thread case).
+    nthread = 0 if threads == 1 else threads
+    with rollout.Rollout(nthread=nthread) as pool:
+
+        def setup():
+            return lambda: pool.rollout(
+                model,
+                datas,
+                initial,
+                control,
+                nstep=steps,
+                state=state,
+                sensordata=sensordata,
+            )
+
+        return copies * steps / best(setup, repeat)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="small sizes, to try the script")
+    parser.add_argument("--repeat", type=int, default=3)
+    args = parser.parse_args()
+    scale = 8 if args.quick else 1
+    cart, ragdoll = (1024 // scale, 500 // scale), (64 // scale, 300 // scale)
+    load = os.getloadavg()
+    print(f"load average before: {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}; cores: {os.cpu_count()}")
+    rows = []
+    for threads in (1, 2):
+        w, n = cart
+        step = tumble_case(CART_POLE, w, n, threads, args.repeat, record=False)
+        rec = tumble_case(CART_POLE, w, n, threads, args.repeat, record=True)
+        mj = mujoco_case(w, n, threads, args.repeat)
+        rows.append((f"{w} cart-poles", threads, step, rec, mj))
+        step = tumble_case(CART_POLE_1, w, n, threads, args.repeat, record=False)
+        rec = tumble_case(CART_POLE_1, w, n, threads, args.repeat, record=True)
+        rows.append((f"{w} cart-poles, 1 substep", threads, step, rec, mj))
+        w, n = ragdoll
+        # The ragdolls start as the scene does (see the note on kicks in the README).
+        step = tumble_case("ragdoll", w, n, threads, args.repeat, record=False, kick=0)
+        rec = tumble_case("ragdoll", w, n, threads, args.repeat, record=True, kick=0)
+        rows.append((f"{w} ragdolls", threads, step, rec, None))
+    print()
+    head = ("case", "threads", "tumble step", "tumble simulate", "mujoco rollout", "simulate / rollout")
+    print("| " + " | ".join(head) + " |")
+    print("|" + "---|" * len(head))
+    for case, threads, step, rec, mj in rows:
+        ratio = f"{rec / mj:.2f}" if mj else "-"
+        mjs = f"{mj:,.0f}" if mj else "-"
+        print(f"| {case} | {threads} | {step:,.0f} | {rec:,.0f} | {mjs} | {ratio} |")
+    print("\nworld-steps per second (W × steps / s), best of", args.repeat)
+    load = os.getloadavg()
+    print(f"load average after: {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}")
+    print(json.dumps({r[0] + f" x{r[1]}": r[2:] for r in rows}))
+
+
+if __name__ == "__main__":
+    main()
