@@ -18,6 +18,8 @@ mod joints;
 mod mjcf;
 mod models;
 mod query;
+mod render;
+mod scenes;
 mod shapes;
 mod sim;
 mod snapshots;
@@ -54,5 +56,6 @@ fn tumble_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     character::register(m)?;
     callbacks::register(m)?;
     models::register(m)?;
+    scenes::register(m)?;
     Ok(())
 }
