@@ -219,3 +219,42 @@ def test_pusher_reaches_goal():
         if term:
             break
     assert term and r > 5 and abs(obs[2] - 0.3) < 0.05
+
+
+needs_batch = pytest.mark.skipif(not hasattr(tumble, "Batch"), reason="tumble.Batch not built in")
+
+
+def test_vector_envs_need_batch():
+    import tumble.envs.vector as vector
+
+    assert gym.spec("tumble/Pusher-v0").vector_entry_point is None
+    if not hasattr(tumble, "Batch"):
+        with pytest.raises(ImportError, match="tumble.Batch"):
+            vector.CartPoleVectorEnv(2)
+
+
+@needs_batch
+@pytest.mark.parametrize("env_id", ["tumble/CartPole-v0", "tumble/Pendulum-v0", "tumble/Acrobot-v0"])
+def test_vector_env_follows_the_single_one(env_id):
+    """Each copy of the vectorised environment follows the single environment started in
+    the same state and given the same actions (to 1e-6: the torques of Pendulum and Acrobot
+    go in as body torques rather than motors, the same physics by other arithmetic)."""
+    venv = gym.make_vec(env_id, num_envs=3, vectorization_mode="vector_entry_point")
+    obs, _ = venv.reset(seed=5)
+    assert obs.shape == (3, *venv.single_observation_space.shape) and obs.dtype == np.float32
+    u = venv.unwrapped
+    starts = u._state()
+    singles = []
+    for i in range(3):
+        e = gym.make(env_id).unwrapped
+        e.reset(seed=0)
+        e._pose(*starts[i])
+        singles.append(e)
+    venv.action_space.seed(1)
+    for _ in range(5):
+        acts = venv.action_space.sample()
+        obs, rew, term, trunc, _ = venv.step(acts)
+        for i, e in enumerate(singles):
+            o, r, *_ = e.step(acts[i])
+            np.testing.assert_allclose(obs[i], o, atol=1e-6)
+    venv.close()

@@ -18,9 +18,10 @@ tumble/Pusher-v0       :class:`PusherEnv`          Box(-1, 1, (2,))    200
 =====================  ==========================  ==================  ==========
 
 Each class's docstring and docs/envs.md give the observation, reward, termination and
-start state. The vectorised versions (``gym.make_vec(id, num_envs=W,
+start state. The vectorised versions of the first three (``gym.make_vec(id, num_envs=W,
 vectorization_mode="vector_entry_point")``, module :mod:`tumble.envs.vector`) step W
-copies in one ``tumble.Batch`` and are imported only when asked for.
+copies in one ``tumble.Batch`` and are imported only when asked for; they need
+``tumble.Batch``.
 """
 
 from __future__ import annotations
@@ -45,10 +46,12 @@ def register() -> None:
     for env_id, (module, cls, steps) in ENVS.items():
         if env_id in gym.envs.registry:
             continue
+        # The Pusher has no vectorised version (see tumble.envs.vector).
+        vector = None if module == "pusher" else f"tumble.envs.vector:{cls[:-3]}VectorEnv"
         gym.register(
             id=env_id,
             entry_point=f"tumble.envs.{module}:{cls}",
-            vector_entry_point=f"tumble.envs.vector:{cls.replace('Env', 'VectorEnv')}",
+            vector_entry_point=vector,
             max_episode_steps=steps,
         )
 

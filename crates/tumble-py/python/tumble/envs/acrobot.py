@@ -79,8 +79,8 @@ class AcrobotEnv(TumbleEnv):
         )
         self.world = w
 
-    def _pose(self, t1: float, t2: float, r1: float, r2: float) -> None:
-        """Places both links at angles (t1, t2) and rates (r1, r2), on their hinges."""
+    def arrays(self, t1: float, t2: float, r1: float, r2: float) -> dict:
+        """set_state's arrays for both links at angles (t1, t2) and rates (r1, r2)."""
         l, a = self.length, t1 + t2
         d1 = (math.sin(t1) * l, -math.cos(t1) * l)
         d2 = (math.sin(a) * l, -math.cos(a) * l)
@@ -89,12 +89,16 @@ class AcrobotEnv(TumbleEnv):
         w1, w2 = r1, r1 + r2
         v1 = (-w1 * c1[1], w1 * c1[0], 0)  # (w z) x c1
         v2 = (-w1 * d1[1] - w2 * d2[1] / 2, w1 * d1[0] + w2 * d2[0] / 2, 0)
-        self._world().set_state(
+        return dict(
             positions=[c1, c2],
             orientations=[_axis_angle_z(t1), _axis_angle_z(a)],
             velocities=[v1, v2],
             angular_velocities=[(0, 0, w1), (0, 0, w2)],
         )
+
+    def _pose(self, t1: float, t2: float, r1: float, r2: float) -> None:
+        """Places both links at angles (t1, t2) and rates (r1, r2), on their hinges."""
+        self._world().set_state(**self.arrays(t1, t2, r1, r2))
 
     def _state(self) -> tuple:
         s, e = self.shoulder, self.elbow

@@ -82,16 +82,20 @@ class CartPoleEnv(TumbleEnv):
         )
         self.world = w
 
-    def _pose(self, x: float, x_dot: float, theta: float, theta_dot: float) -> None:
-        """Places cart and pole at the state (x, x_dot, theta, theta_dot), rigidly consistent."""
+    def arrays(self, x: float, x_dot: float, theta: float, theta_dot: float) -> dict:
+        """set_state's arrays (cart, pole) for the state (x, x_dot, theta, theta_dot):
+        the pole's pose and velocity rigidly consistent with the hinge and the slider."""
         h, s, c = self.half_length, math.sin(theta), math.cos(theta)
-        w = self._world()
-        w.set_state(
+        return dict(
             positions=[(x, 0, 0), (x + h * s, h * c, 0)],
             orientations=[(0, 0, 0, 1), _axis_angle_z(theta, -1.0)],
             velocities=[(x_dot, 0, 0), (x_dot + h * c * theta_dot, -h * s * theta_dot, 0)],
             angular_velocities=[(0, 0, 0), (0, 0, -theta_dot)],
         )
+
+    def _pose(self, *state: float) -> None:
+        """Places cart and pole at the state (x, x_dot, theta, theta_dot)."""
+        self._world().set_state(**self.arrays(*state))
 
     def _obs(self) -> np.ndarray:
         return np.array(

@@ -73,14 +73,18 @@ class PendulumEnv(TumbleEnv):
         )
         self.world = w
 
-    def _pose(self, theta: float, theta_dot: float) -> None:
+    def arrays(self, theta: float, theta_dot: float) -> dict:
+        """set_state's arrays for the rod at (theta, theta_dot), on its hinge."""
         h, s, c = self.length / 2, math.sin(theta), math.cos(theta)
-        self._world().set_state(
+        return dict(
             positions=[(-h * s, h * c, 0)],
             orientations=[_axis_angle_z(theta)],
             velocities=[(-h * c * theta_dot, -h * s * theta_dot, 0)],
             angular_velocities=[(0, 0, theta_dot)],
         )
+
+    def _pose(self, theta: float, theta_dot: float) -> None:
+        self._world().set_state(**self.arrays(theta, theta_dot))
 
     def _state(self) -> tuple:
         return float(self.hinge.position), float(self.hinge.velocity)
