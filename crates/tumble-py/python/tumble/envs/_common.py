@@ -1,4 +1,4 @@
-"""What the environments share: the gymnasium import, motor actuation, rendering."""
+"""What the environments share: the gymnasium import, actuation, rendering."""
 
 from __future__ import annotations
 
@@ -27,6 +27,21 @@ FAR = 1.0e3
 def drive(joint: tumble.Joint, effort: float) -> None:
     """Applies `effort` (N or N·m, signed) along `joint` through its motor for the next steps."""
     joint.motor = tumble.Motor(math.copysign(FAR, effort), abs(float(effort)))
+
+
+class Efforts:
+    """Constant torques on bodies for the next steps: each call replaces the last's (as
+    world.add_force elements; tumble.Batch.apply_forces does the same per world, so the
+    vectorised environments follow the single ones bit for bit)."""
+
+    def __init__(self) -> None:
+        self.ids: list = []
+
+    def apply(self, world: tumble.World, torques: list) -> None:
+        """`torques`: (body, (tx, ty, tz)) pairs, N·m."""
+        for i in self.ids:
+            world.remove_force(i)
+        self.ids = [world.add_force(b, torque=t) for b, t in torques]
 
 
 class TumbleEnv(gym.Env):
@@ -67,4 +82,4 @@ def wrap(angle: float) -> float:
     return (angle + math.pi) % (2 * math.pi) - math.pi
 
 
-__all__ = ["gym", "spaces", "np", "drive", "TumbleEnv", "wrap", "FAR"]
+__all__ = ["gym", "spaces", "np", "drive", "Efforts", "TumbleEnv", "wrap", "FAR"]

@@ -1,4 +1,4 @@
-"""Acrobot: a two-link chain hanging from a fixed hinge, swung up by a motor at the elbow."""
+"""Acrobot: a two-link chain hanging from a fixed hinge, swung up by a torque at the elbow."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from typing import Any, Optional
 
 import tumble
 
-from ._common import TumbleEnv, drive, np, spaces, wrap
+from ._common import Efforts, TumbleEnv, np, spaces, wrap
 from .cartpole import _axis_angle_z
 
 
@@ -19,7 +19,9 @@ class AcrobotEnv(TumbleEnv):
     classic task; set through ``inertia``). The upper link hangs on a ``hinge``
     ("shoulder") to the world at the origin, the lower on a ``hinge`` ("elbow") at the
     upper link's end, both about +z; gravity 9.8 m/s² along -y. Only the elbow is driven:
-    its motor, saturated at |torque|, turns the two links against each other.
+    its torque turns the lower link by +torque and the upper by -torque about +z (what a
+    motor at the elbow exerts; applied as body torques, which tumble.Batch takes per world,
+    so the vectorised version is the same).
 
     - Action space: ``Discrete(3)``: elbow torque -1, 0 or +1 N·m.
     - Observation space: ``Box(6,)`` float32, ``[cos t1, sin t1, cos t2, sin t2, t1_dot,
@@ -78,6 +80,7 @@ class AcrobotEnv(TumbleEnv):
             axis=z, other_axis=z, name="elbow",
         )
         self.world = w
+        self.efforts = Efforts()
 
     def arrays(self, t1: float, t2: float, r1: float, r2: float) -> dict:
         """set_state's arrays for both links at angles (t1, t2) and rates (r1, r2)."""
@@ -126,10 +129,8 @@ class AcrobotEnv(TumbleEnv):
         if not self.action_space.contains(action):
             raise ValueError(f"action: must be 0, 1 or 2, got {action!r}")
         torque = self.torques[int(action)]
-        if torque == 0.0:
-            self.elbow.motor = None
-        else:
-            drive(self.elbow, torque)
+        z = (0.0, 0.0, torque)
+        self.efforts.apply(self._world(), [(self.upper, (0.0, 0.0, -torque)), (self.lower, z)])
         self._world().step(self.dt / self.substeps, steps=self.substeps)
         t1, t2, r1, r2 = self._state()
         c1 = float(np.clip(r1, -self.max_rates[0], self.max_rates[0]))

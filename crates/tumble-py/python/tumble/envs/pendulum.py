@@ -1,4 +1,4 @@
-"""Pendulum: swing a rod hinged at one end up and hold it there with a weak motor."""
+"""Pendulum: swing a rod hinged at one end up and hold it there with a weak torque."""
 
 from __future__ import annotations
 
@@ -7,17 +7,18 @@ from typing import Any, Optional
 
 import tumble
 
-from ._common import TumbleEnv, drive, np, spaces, wrap
+from ._common import Efforts, TumbleEnv, np, spaces, wrap
 from .cartpole import _axis_angle_z
 
 
 class PendulumEnv(TumbleEnv):
-    """The inverted-pendulum swing-up, simulated by Tumble's hinge and its motor.
+    """The inverted-pendulum swing-up, simulated by Tumble's hinge.
 
     Mechanism: a uniform rod of 1 kg and 1 m (a thin box whose inertia is set to the thin
     rod's, m l²/12 about its centre, so m l²/3 about the pivot) on a ``hinge`` joint to
-    the world at its lower end, about +z; gravity 10 m/s² along -y. The torque is the
-    hinge's motor, saturated at |u| (exactly u all step long).
+    the world at its lower end, about +z; gravity 10 m/s² along -y. The torque acts on the
+    rod about +z, constant over the step (what a motor at the hinge exerts; applied as a
+    body torque, which tumble.Batch takes per world, so the vectorised version is the same).
 
     - Action space: ``Box(-2, 2, (1,))`` float32, the torque u (N·m, +z), clipped to ±2.
     - Observation space: ``Box(3,)`` float32, ``[cos(theta), sin(theta), theta_dot]``,
@@ -72,6 +73,7 @@ class PendulumEnv(TumbleEnv):
             name="hinge",
         )
         self.world = w
+        self.efforts = Efforts()
 
     def arrays(self, theta: float, theta_dot: float) -> dict:
         """set_state's arrays for the rod at (theta, theta_dot), on its hinge."""
@@ -110,7 +112,7 @@ class PendulumEnv(TumbleEnv):
         u = float(np.clip(u[0], -self.max_torque, self.max_torque))
         theta, theta_dot = self._state()
         cost = wrap(theta) ** 2 + 0.1 * theta_dot**2 + 0.001 * u**2
-        drive(self.hinge, u)
+        self.efforts.apply(self._world(), [(self.rod, (0.0, 0.0, u))])
         self._world().step(self.dt / self.substeps, steps=self.substeps)
         theta, theta_dot = self._state()
         if abs(theta_dot) > self.max_speed:

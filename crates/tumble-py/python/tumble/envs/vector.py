@@ -8,14 +8,15 @@ end are reset on the next ``step`` (Gymnasium's NEXT_STEP autoreset): that step 
 new episode's first observation with reward 0.
 
 CartPole's push is its slider's motor, as in the single environment (the batch sets each
-world's motor speed to ±FAR); Pendulum's and Acrobot's torques are applied as body torques
-(``Batch.apply_forces``; the elbow's as an equal and opposite pair on the two links), the
-same physics as the single environments' hinge motors but not the same bits. The Pusher
+world's motor speed to ±FAR); Pendulum's and Acrobot's torques are body torques
+(``Batch.apply_forces``; the elbow's an equal and opposite pair on the two links), as in
+the single environments. The Pusher
 has no vectorised version (its pusher is moved by kinematic targets, which a Batch does
 not take per world).
 
 STATUS: written against the Batch API of issue 20 point 1 before that was merged; it needs
-``tumble.Batch`` and was not run here.
+``tumble.Batch``. tests/test_envs.py runs it against a stand-in made of W Worlds (the
+part of Batch's API used here) until the real one is built in.
 """
 
 from __future__ import annotations
