@@ -20,6 +20,7 @@ mod render;
 mod report;
 mod run;
 mod sample;
+mod sweep;
 mod web;
 
 use std::io::{self, Write};
@@ -92,6 +93,11 @@ enum Command {
     /// in its colour, and its translation and rotation keyframed at every recorded step
     /// (the steps `tumble run --out` records with the same options), time in seconds.
     ExportGltf(export_gltf::GltfArgs),
+    /// Run every combination of a grid of scene values (--set PATH=V1,V2,...) and print a
+    /// CSV table of metrics from a fixed menu (--metric), one row per run in the grid's
+    /// order; a failed run keeps its parameters and its one-line error. Runs here, one
+    /// after another; with --ray ADDRESS on a Ray cluster through Python's tumble.sweep.
+    Sweep(sweep::SweepArgs),
 }
 
 /// Why the program stops early.
@@ -154,6 +160,7 @@ fn main() -> ExitCode {
         Command::Scenes => report::list_scenes(),
         Command::Contacts(args) => contacts::contacts(&args),
         Command::Render(args) => render::render(&args),
+        Command::Sweep(args) => sweep::sweep(&args),
     };
     match result {
         Ok(()) | Err(Failure::Closed) => ExitCode::SUCCESS,

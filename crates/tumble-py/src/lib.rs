@@ -19,6 +19,8 @@ mod joints;
 mod mjcf;
 mod models;
 mod query;
+mod render;
+mod scenes;
 mod shapes;
 mod sim;
 mod snapshots;
@@ -56,5 +58,6 @@ fn tumble_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     callbacks::register(m)?;
     models::register(m)?;
     batch::register(m)?;
+    scenes::register(m)?;
     Ok(())
 }

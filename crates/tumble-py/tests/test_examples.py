@@ -7,7 +7,7 @@ import sys
 
 import pytest
 
-EXAMPLES = ["free_fall", "integrator_order", "spring_energy", "dzhanibekov"]
+EXAMPLES = ["free_fall", "integrator_order", "spring_energy", "dzhanibekov", "restitution_sweep"]
 
 
 @pytest.mark.parametrize("name", EXAMPLES)

@@ -52,6 +52,15 @@ from ._tumble import (
     __version__,
 )
 
+
+def sweep(scene, grid, metrics, duration=None, address=None, **options):
+    """Runs every combination of a grid of scene parameters (on Ray, or serially) and returns
+    the table of results: see tumble.sweep's module documentation (tumble/sweep.py)."""
+    from .sweep import sweep as run
+
+    return run(scene, grid, metrics, duration, address, **options)
+
+
 __all__ = [
     "INTEGRATORS",
     "SCENES",
@@ -88,4 +97,5 @@ __all__ = [
     "TriMesh",
     "World",
     "__version__",
+    "sweep",
 ]

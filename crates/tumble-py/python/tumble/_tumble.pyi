@@ -799,6 +799,20 @@ class World:
     def contact_margin(self) -> float: ...
     def diagnostics(self) -> Diagnostics:
         """Energies, momentum and angular momentum of the current state."""
+    def render(
+        self,
+        width: int = 320,
+        height: int = 240,
+        *,
+        camera: Optional[Vec3Like] = None,
+        target: Optional[Vec3Like] = None,
+        contacts: bool = False,
+        joints: bool = False,
+        time: bool = False,
+    ) -> npt.NDArray[np.uint8]:
+        """The world now as an (height, width, 3) uint8 RGB array, drawn as `tumble render`
+        draws a frame; the camera at `camera` looking at `target` (default: framing the
+        moving bodies, from the front, a little right and above). Sides 1 to 4096."""
     def state_hash(self) -> int:
         """Equal hashes mean bit-identical states."""
     def snapshot(self) -> bytes:
@@ -994,3 +1008,6 @@ class CharacterController:
     def max_push_force(self) -> float: ...
     @property
     def up(self) -> F64Array: ...
+
+def builtin_scene(name: str) -> str:
+    """The JSON text of the built-in scene `name` (one of SCENES); ValueError if none."""
