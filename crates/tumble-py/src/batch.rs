@@ -782,6 +782,7 @@ impl PyBatch {
             dt: g.dt,
             duration: g.duration,
             callbacks: None,
+            mjcf: None,
         }))
     }
 
