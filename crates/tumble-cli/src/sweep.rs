@@ -16,7 +16,7 @@ use serde_json::Value;
 use tumble::{BodyKind, Real};
 use tumble_scene::RunPlan;
 
-use crate::output::{Target, Writer};
+use crate::output::{check_distinct, Target, Writer};
 use crate::record::{csv_text, Num};
 use crate::Failure;
 
@@ -97,7 +97,11 @@ pub fn sweep(args: &SweepArgs) -> Result<(), Failure> {
         }
     }
     let mut out = match &args.out {
-        Some(path) => Some(Writer::create(Target::file("out", path)?)?),
+        Some(path) => {
+            let target = Target::file("out", path)?;
+            check_distinct(&[&target], &[("scene", Path::new(&args.scene))])?;
+            Some(Writer::create(target)?)
+        }
         None => None,
     };
     let combos = combinations(&grid);
