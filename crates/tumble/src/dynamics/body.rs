@@ -454,16 +454,11 @@ impl Body {
     }
 
     /// ω from L for this body at orientation `q`: ω = R I⁻¹ Rᵀ L, or for a planar body
-    /// the seed's 2D rule ω_z = L_z / I_zz. A ball-like body (equal principal moments:
-    /// spheres, cubes) has I⁻¹ = 1/I whatever its orientation, so ω = L / I without the
-    /// two rotations: the solver calls this two or three times a substep for every body
-    /// (kicks and drift), 9 % of the joint grid's time before.
+    /// the seed's 2D rule ω_z = L_z / I_zz.
     #[inline]
     pub(crate) fn omega_from_momentum(&self, q: Quat, l: Vec3) -> Vec3 {
         if self.planar {
             Vec3::new(0.0, 0.0, l.z / self.planar_inertia)
-        } else if self.isotropic {
-            l / self.principal_moments.x
         } else {
             q * (self.inv_inertia_local * (q.inverse() * l))
         }
@@ -473,8 +468,6 @@ impl Body {
     pub(crate) fn momentum_from_omega(&self, q: Quat, w: Vec3) -> Vec3 {
         if self.planar {
             Vec3::new(0.0, 0.0, w.z * self.planar_inertia)
-        } else if self.isotropic {
-            w * self.principal_moments.x
         } else {
             q * (self.inertia_local * (q.inverse() * w))
         }
