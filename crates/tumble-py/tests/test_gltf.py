@@ -8,7 +8,6 @@ else built with cargo."""
 
 import csv
 import json
-import os
 import struct
 import subprocess
 
@@ -47,20 +46,6 @@ SCENE = {
 
 # Half sizes of each moving body's mesh in its own frame (m).
 HALF = {"crate": [0.5, 0.2, 0.3], "ball": [0.25] * 3, "pill": [0.1, 0.5, 0.1]}
-
-
-@pytest.fixture()
-def binary(root):
-    if os.environ.get("TUMBLE_BIN"):
-        return os.environ["TUMBLE_BIN"]
-    built = [root / "target" / kind / "tumble" for kind in ("release", "debug")]
-    built = [p for p in built if p.exists()]
-    if not built:
-        subprocess.run(
-            ["cargo", "build", "--release", "--locked", "--bin", "tumble"], cwd=root, check=True
-        )
-        built = [root / "target" / "release" / "tumble"]
-    return str(max(built, key=lambda p: p.stat().st_mtime))
 
 
 @pytest.fixture()

@@ -135,18 +135,6 @@ def test_built_in_scene_and_file(tmp_path):
         assert r["ball.y"] == pytest.approx(5 - g * 0.01**2 * 100 * 101 / 2, abs=1e-9)
 
 
-@pytest.fixture()
-def binary(root):
-    if os.environ.get("TUMBLE_BIN"):
-        return os.environ["TUMBLE_BIN"]
-    built = [root / "target" / kind / "tumble" for kind in ("release", "debug")]
-    built = [p for p in built if p.exists()]
-    if not built:
-        subprocess.run(["cargo", "build", "--release", "--locked", "--bin", "tumble"], cwd=root, check=True)
-        built = [root / "target" / "release" / "tumble"]
-    return str(max(built, key=lambda p: p.stat().st_mtime))
-
-
 CLI_SETS = ["bodies[ball].restitution=0,0.5,0.9", "bodies[0].friction=0.3,1", "gravity=[0,-9.8,0],[0,-3,0]"]
 CLI_METRICS = ["ball.y", "ball.vy", "ball.max_y", "box.speed", "kinetic_energy", "asleep", "time"]
 
