@@ -905,6 +905,7 @@ fn drift_body((sim, state): (&mut BodySim, &mut BodyState), body: &Body, h: Real
             sim.sync_momentum(state);
             sim.x += state.v * h;
             sim.q = rotor_drift(body, sim.q, sim.l, state.w, h);
+            sim.turn_inertia(body);
             state.w = body.omega_from_momentum(sim.q, sim.l);
             sim.w_synced = state.w;
         }
