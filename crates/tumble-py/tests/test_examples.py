@@ -7,7 +7,14 @@ import sys
 
 import pytest
 
-EXAMPLES = ["free_fall", "integrator_order", "spring_energy", "dzhanibekov", "restitution_sweep"]
+EXAMPLES = [
+    "free_fall",
+    "integrator_order",
+    "spring_energy",
+    "dzhanibekov",
+    "restitution_sweep",
+    "cartpole_pd_batch",
+]
 
 
 @pytest.mark.parametrize("name", EXAMPLES)
