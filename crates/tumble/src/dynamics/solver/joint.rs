@@ -42,6 +42,7 @@ use super::body::{BodySim, BodyState};
 use super::softness::Softness;
 use crate::dynamics::joint::{AngularLock, Joint, JointImpulses, KindSpec, LinearLock};
 use crate::math::{Mat3, Quat, Real, Vec3};
+pub(crate) use block::Block;
 use block::{apply_point, point_impulse, point_inverse_mass, solve_hard, solve_point};
 use one_d::{free_impulse, solve_free, solve_limit, FreeDrive};
 
@@ -170,6 +171,10 @@ pub(crate) struct JointConstraint {
     /// there is, and the passes go straight to it (the row builders cost the joint grid
     /// a tenth of its time finding they had nothing to build).
     plain_ball: bool,
+    /// Where this joint's hard block sits in the solver's list of them (made once per
+    /// frame, see `block::Block`); `None` for joints without hard rows solved as a block
+    /// (ball and distance joints).
+    pub block: Option<usize>,
 }
 
 /// Where the geometry of a joint stands at the bodies' current poses. Poses change only
@@ -217,7 +222,24 @@ impl JointConstraint {
             total_angular: Vec3::ZERO,
             point_mass: None,
             plain_ball,
+            block: None,
         }
+    }
+
+    /// Whether the joint has hard rows solved as one block (see `joint_rows.rs`).
+    pub fn has_block(&self) -> bool {
+        !self.point_apart()
+            && (self.spec.linear != LinearLock::Free || self.spec.angular != AngularLock::Free)
+    }
+
+    /// The joint's hard block at frame `fr`, from `blocks` (the solver's, emptied after
+    /// each drift), made there if missing.
+    fn block<'b>(&self, fr: &Frame, blocks: &'b mut [Option<Block>]) -> Option<&'b Block> {
+        let slot = &mut blocks[self.block?];
+        if slot.is_none() {
+            *slot = self.hard_rows(fr).map(|hard| Block::new(hard, fr));
+        }
+        slot.as_ref()
     }
 
     /// Dense indices of the two bodies (`None`: the world).
@@ -282,7 +304,12 @@ impl JointConstraint {
     }
 
     /// Applies the accumulated impulses again (every substep).
-    pub fn warm_start(&mut self, fr: &Frame, states: &mut [BodyState]) {
+    pub fn warm_start(
+        &mut self,
+        fr: &Frame,
+        states: &mut [BodyState],
+        blocks: &mut [Option<Block>],
+    ) {
         self.point_mass = None;
         if self.plain_ball {
             let p = point_impulse(&self.impulses);
@@ -290,7 +317,7 @@ impl JointConstraint {
             return;
         }
         let imp = self.impulses;
-        let hard = self.hard_rows(fr);
+        let hard = self.block(fr, blocks).map(|b| &b.hard);
         let free = self.free_row(fr);
         let cone = self.cone_row(fr);
         let point = self.point_apart().then(|| point_impulse(&imp));
@@ -314,7 +341,13 @@ impl JointConstraint {
     }
 
     /// One pass over the joint's rows.
-    pub fn solve(&mut self, fr: &Frame, states: &mut [BodyState], pass: &JointPass) {
+    pub fn solve(
+        &mut self,
+        fr: &Frame,
+        states: &mut [BodyState],
+        pass: &JointPass,
+        blocks: &mut [Option<Block>],
+    ) {
         if self.plain_ball {
             let k_inv = *self
                 .point_mass
@@ -328,7 +361,7 @@ impl JointConstraint {
         let drive = self.drive;
         let free = self.free_row(fr);
         let cone = self.cone_row(fr);
-        let hard = self.hard_rows(fr);
+        let hard = self.block(fr, blocks);
         let point_mass = self.point_apart().then(|| {
             *self
                 .point_mass
@@ -341,8 +374,8 @@ impl JointConstraint {
             if let Some((row, c)) = cone {
                 imp.cone = solve_limit(row, c, imp.cone, fr, pass, a, b);
             }
-            if let Some(hard) = &hard {
-                imp.hard = solve_hard(hard, imp.hard, fr, pass, a, b);
+            if let Some(block) = hard {
+                imp.hard = solve_hard(block, imp.hard, fr, pass, a, b);
             }
             if let Some(k_inv) = point_mass {
                 let p = solve_point(point_impulse(&imp), k_inv, fr, pass, a, b);
@@ -354,14 +387,14 @@ impl JointConstraint {
 
     /// Adds the substep's impulses to the step's totals: the force on `other` at its
     /// anchor and the pure torques.
-    pub fn add_to_totals(&mut self, fr: &Frame) {
+    pub fn add_to_totals(&mut self, fr: &Frame, blocks: &mut [Option<Block>]) {
         let imp = self.impulses;
         if self.plain_ball {
             // The point's impulse is all there is, and it is already a world vector.
             self.total_linear += point_impulse(&imp);
             return;
         }
-        let hard = self.hard_rows(fr);
+        let hard = self.block(fr, blocks).map(|b| &b.hard);
         let free = self.free_row(fr).map(|(row, _)| (row, free_impulse(&imp)));
         let cone = self.cone_row(fr).map(|(row, _)| (row, imp.cone));
         let rows = hard

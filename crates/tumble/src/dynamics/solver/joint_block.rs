@@ -98,7 +98,7 @@ pub(super) fn solve_point(
             count: 3,
         };
         let acc6 = [acc.x, acc.y, acc.z, 0.0, 0.0, 0.0];
-        let total = solve_hard(&hard, acc6, fr, pass, a, b);
+        let total = solve_hard(&Block::new(hard, fr), acc6, fr, pass, a, b);
         return Vec3::new(total[0], total[1], total[2]);
     };
     let impulse = x * pass.soft.mass_scale - acc * pass.soft.impulse_scale;
@@ -107,6 +107,7 @@ pub(super) fn solve_point(
 }
 
 /// The hard rows of a joint: Jacobians and position errors, `count` of them in use.
+#[derive(Clone)]
 pub(super) struct HardRows {
     pub rows: [Row; 6],
     pub error: [Real; 6],
@@ -131,72 +132,134 @@ impl HardRows {
     }
 }
 
-/// Solves the n×n system `k x = rhs` in place by Gaussian elimination with partial
-/// pivoting; a vanishing pivot (a direction no body can move in, such as out of a planar
-/// body's plane) leaves that unknown zero.
-fn solve_dense(k: &mut [[Real; 6]; 6], rhs: &mut [Real; 6], n: usize) -> [Real; 6] {
-    let scale = (0..n).map(|i| k[i][i].abs()).fold(0.0, Real::max);
-    let tiny = 1e-12 * scale;
-    let mut skip = [false; 6];
-    for col in 0..n {
-        let pivot = (col..n)
-            .max_by(|&i, &j| k[i][col].abs().total_cmp(&k[j][col].abs()))
-            .unwrap_or(col);
-        k.swap(col, pivot);
-        rhs.swap(col, pivot);
-        if k[col][col].abs() <= tiny {
-            skip[col] = true;
-            continue;
-        }
-        let pivot_row = k[col];
-        for i in col + 1..n {
-            let f = k[i][col] / pivot_row[col];
-            for (kij, pj) in k[i][col..n].iter_mut().zip(&pivot_row[col..n]) {
-                *kij -= f * pj;
+/// K = J M⁻¹ Jᵀ of a joint's hard rows, eliminated once per frame: Gaussian elimination
+/// with partial pivoting, its multipliers and row swaps recorded, so that each pass only
+/// replays them on its own right-hand side. The pivots depend on K alone, so the replay
+/// does bit for bit the arithmetic of eliminating K and the right-hand side together (as
+/// each pass did before: K's build and elimination were 36 % of a cart-pole's step, made
+/// twice per frame). A vanishing pivot (a direction no body can move in, such as out of a
+/// planar body's plane) leaves that unknown zero.
+#[derive(Clone, Default)]
+pub(super) struct Eliminated {
+    /// The upper triangle left by the elimination.
+    k: [[Real; 6]; 6],
+    /// Per column, the row swapped into the pivot's place, and the multipliers of the
+    /// rows below it.
+    pivot: [usize; 6],
+    factor: [[Real; 6]; 6],
+    skip: [bool; 6],
+    n: usize,
+}
+
+impl Eliminated {
+    /// Eliminates the n×n matrix `k`.
+    fn new(mut k: [[Real; 6]; 6], n: usize) -> Eliminated {
+        let scale = (0..n).map(|i| k[i][i].abs()).fold(0.0, Real::max);
+        let tiny = 1e-12 * scale;
+        let mut e = Eliminated {
+            n,
+            ..Eliminated::default()
+        };
+        for col in 0..n {
+            let pivot = (col..n)
+                .max_by(|&i, &j| k[i][col].abs().total_cmp(&k[j][col].abs()))
+                .unwrap_or(col);
+            k.swap(col, pivot);
+            e.pivot[col] = pivot;
+            if k[col][col].abs() <= tiny {
+                e.skip[col] = true;
+                continue;
             }
-            rhs[i] -= f * rhs[col];
+            let pivot_row = k[col];
+            let below = k[col + 1..n].iter_mut().zip(&mut e.factor[col][col + 1..n]);
+            for (row, factor) in below {
+                let f = row[col] / pivot_row[col];
+                for (kij, pj) in row[col..n].iter_mut().zip(&pivot_row[col..n]) {
+                    *kij -= f * pj;
+                }
+                *factor = f;
+            }
+        }
+        e.k = k;
+        e
+    }
+
+    /// x with K x = `rhs`.
+    fn solve(&self, mut rhs: [Real; 6]) -> [Real; 6] {
+        let (k, n) = (&self.k, self.n);
+        for col in 0..n {
+            rhs.swap(col, self.pivot[col]);
+            if self.skip[col] {
+                continue;
+            }
+            for i in col + 1..n {
+                rhs[i] -= self.factor[col][i] * rhs[col];
+            }
+        }
+        let mut x = [0.0; 6];
+        for i in (0..n).rev() {
+            if self.skip[i] {
+                continue;
+            }
+            let sum: Real = (i + 1..n).map(|j| k[i][j] * x[j]).sum();
+            x[i] = (rhs[i] - sum) / k[i][i];
+        }
+        x
+    }
+}
+
+/// A joint's hard rows at one frame with their K eliminated: made once per frame (the
+/// rows were built again by the warm start, each pass and the totals).
+#[derive(Clone, Default)]
+pub(crate) struct Block {
+    pub(super) hard: HardRows,
+    k: Eliminated,
+}
+
+impl Block {
+    /// The block of the rows `hard` at frame `fr`.
+    pub(super) fn new(hard: HardRows, fr: &Frame) -> Block {
+        let n = hard.count;
+        let mut k = [[0.0; 6]; 6];
+        let (sa, sb) = (&fr.sa, &fr.sb);
+        for i in 0..n {
+            let ri = &hard.rows[i];
+            // M⁻¹ Jᵢᵀ, dotted with every row.
+            let (va, wa) = (sa.mask * ri.lin * sa.inv_mass, sa.inv_inertia * ri.ang_a);
+            let (vb, wb) = (sb.mask * ri.lin * sb.inv_mass, sb.inv_inertia * ri.ang_b);
+            for (kj, rj) in k.iter_mut().zip(&hard.rows[..n]) {
+                kj[i] = rj.lin.dot(va + vb) + rj.ang_a.dot(wa) + rj.ang_b.dot(wb);
+            }
+        }
+        Block {
+            k: Eliminated::new(k, n),
+            hard,
         }
     }
-    let mut x = [0.0; 6];
-    for i in (0..n).rev() {
-        if skip[i] {
-            continue;
-        }
-        let sum: Real = (i + 1..n).map(|j| k[i][j] * x[j]).sum();
-        x[i] = (rhs[i] - sum) / k[i][i];
-    }
-    x
 }
 
 /// One pass over the hard rows as a block; returns the new accumulated impulses.
 pub(super) fn solve_hard(
-    hard: &HardRows,
+    block: &Block,
     acc: [Real; 6],
     fr: &Frame,
     pass: &JointPass,
     a: &mut BodyState,
     b: &mut BodyState,
 ) -> [Real; 6] {
+    let hard = &block.hard;
     let n = hard.count;
-    let mut k = [[0.0; 6]; 6];
     let mut rhs = [0.0; 6];
-    let (sa, sb) = (&fr.sa, &fr.sb);
-    for i in 0..n {
-        let ri = &hard.rows[i];
-        // M⁻¹ Jᵢᵀ, dotted with every row.
-        let (va, wa) = (sa.mask * ri.lin * sa.inv_mass, sa.inv_inertia * ri.ang_a);
-        let (vb, wb) = (sb.mask * ri.lin * sb.inv_mass, sb.inv_inertia * ri.ang_b);
-        for (kj, rj) in k.iter_mut().zip(&hard.rows[..n]) {
-            kj[i] = rj.lin.dot(va + vb) + rj.ang_a.dot(wa) + rj.ang_b.dot(wb);
-        }
+    for ((r, row), error) in rhs.iter_mut().zip(&hard.rows[..n]).zip(hard.error) {
         let bias = if pass.bias {
-            pass.soft.bias_rate * hard.error[i]
+            pass.soft.bias_rate * error
         } else {
             0.0
         };
-        rhs[i] = -(ri.velocity(a, b) + bias);
+        *r = -(row.velocity(a, b) + bias);
     }
-    let x = solve_dense(&mut k, &mut rhs, n);
+    let x = block.k.solve(rhs);
+    let (sa, sb) = (&fr.sa, &fr.sb);
     let mut total = acc;
     for i in 0..n {
         let delta = pass.soft.mass_scale * x[i] - pass.soft.impulse_scale * acc[i];

@@ -40,7 +40,7 @@ pub use softness::Softness;
 
 pub(crate) use body::{BodySim, BodyState, SolverBodies};
 use contact::{BiasRule, ContactConstraint, PairData, Points};
-use joint::{Frame as JointFrame, JointConstraint, JointPass};
+use joint::{Block as JointBlock, Frame as JointFrame, JointConstraint, JointPass};
 
 use crate::collision::contact::{Contact, ContactMaterial};
 use crate::collision::narrow_phase::Overlap;
@@ -90,6 +90,10 @@ pub(crate) struct Solver {
     /// Each joint's frame at the current poses (see `joint::Frame`), made again after
     /// every drift.
     joint_frames: Vec<JointFrame>,
+    /// The hard blocks of the joints that have one (`JointConstraint::block` says
+    /// where), each made at its first use at the current frames: emptied after each
+    /// drift.
+    joint_blocks: Vec<Option<JointBlock>>,
     /// Per body, whether its island has a large mass ratio (see `mass_ratio`); empty when
     /// none has. Such islands' contacts and joints sit at the end of their lists, from
     /// `heavy_contacts` and `heavy_joints`, and get `heavy_passes` times the passes.
@@ -237,7 +241,7 @@ impl Solver {
             self.fine_substeps(bodies, input, fine_rule);
         }
         for (j, fr) in self.joints.iter_mut().zip(&self.joint_frames) {
-            j.warm_start(fr, &mut bodies.states);
+            j.warm_start(fr, &mut bodies.states, &mut self.joint_blocks);
         }
         contact_wide::warm_start(
             &self.constraints,
@@ -261,7 +265,7 @@ impl Solver {
             ContactConstraint::add_to_totals(&self.points.hot, &mut self.points.cold);
         }
         for (j, fr) in self.joints.iter_mut().zip(&self.joint_frames) {
-            j.add_to_totals(fr);
+            j.add_to_totals(fr, &mut self.joint_blocks);
         }
     }
 
@@ -304,7 +308,7 @@ impl Solver {
             for k in 0..count {
                 let frames = &self.joint_frames[joints.clone()];
                 for (j, fr) in self.joints[joints.clone()].iter_mut().zip(frames) {
-                    j.solve(fr, &mut bodies.states, joint_pass);
+                    j.solve(fr, &mut bodies.states, joint_pass, &mut self.joint_blocks);
                 }
                 let last = totals && k + 1 == count;
                 self.solve_pass(bodies, contacts.clone(), rule, bias, last);
@@ -657,6 +661,13 @@ impl Solver {
             light.extend(heavy);
             self.joints = light;
         }
+        let mut blocks = 0;
+        for j in self.joints.iter_mut().filter(|j| j.has_block()) {
+            j.block = Some(blocks);
+            blocks += 1;
+        }
+        self.joint_blocks.clear();
+        self.joint_blocks.resize(blocks, None);
         self.make_joint_frames(&solver_bodies.sims);
     }
 
@@ -673,6 +684,7 @@ impl Solver {
         for (j, fr) in self.joints.iter().zip(&mut self.joint_frames) {
             j.write_frame(sims, fr);
         }
+        self.joint_blocks.fill(None);
     }
 
     /// The contacts to solve, ordered so that neighbours in the list rarely share a moving
