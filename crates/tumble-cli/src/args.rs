@@ -11,7 +11,7 @@ use std::error::Error as _;
 use clap::error::{ContextKind, ContextValue, ErrorKind};
 use clap::CommandFactory;
 use tumble::Real;
-use tumble_scene::{printable, whole_rule};
+use tumble_scene::{printable, whole_rule, RunPlan, Scene, SceneError, MAX_STEPS};
 
 /// A number, in the options' unit; whether it is in range is checked where it is used, so
 /// the message is the scene format's (`dt: must be > 0`).
@@ -214,5 +214,39 @@ mod tests {
         );
         assert_eq!(whole("10", 1, 10), Ok(10));
         assert_eq!(number("x").unwrap_err(), "expected a number, got 'x'");
+    }
+}
+
+/// `--duration`, `--steps` and `--dt`: how long a run is and its step, each over the
+/// scene's own (`tumble run` and `tumble export-gltf`).
+#[derive(clap::Args, Debug, Default, Clone)]
+pub struct Span {
+    /// Simulated time to run, in seconds (s); overrides the scene's `duration`.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = number)]
+    pub duration: Option<Real>,
+
+    /// Number of steps of dt to take, instead of --duration.
+    #[arg(
+        long,
+        value_name = "N",
+        conflicts_with = "duration",
+        allow_negative_numbers = true,
+        value_parser = |t: &str| whole(t, 0, MAX_STEPS)
+    )]
+    pub steps: Option<u64>,
+
+    /// Time step, in seconds (s); overrides the scene's `dt`. Must be > 0.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = number)]
+    pub dt: Option<Real>,
+}
+
+impl Span {
+    /// The run these options and `scene` make: `steps` of dt, else `duration`.
+    pub fn plan(&self, scene: &Scene) -> Result<RunPlan, SceneError> {
+        let dt = self.dt.unwrap_or(scene.dt);
+        match self.steps {
+            Some(steps) => RunPlan::from_steps(steps, dt),
+            None => RunPlan::from_duration(self.duration.unwrap_or(scene.duration), dt),
+        }
     }
 }

@@ -22,9 +22,9 @@ use serde_json::{json, Value};
 use tumble::{BodyKind, Real, Shape, World};
 use tumble_render::mesh::Geometry;
 use tumble_render::{Model, Rgb};
-use tumble_scene::{printable, RunPlan, Scene, SceneError, MAX_STEPS};
+use tumble_scene::{printable, RunPlan, Scene, SceneError};
 
-use crate::args::{number, whole};
+use crate::args::{whole, Span};
 use crate::glb::{self, Buffer, ARRAY_BUFFER};
 use crate::output::{check_distinct, inputs, scene_file, Staged, Target};
 use crate::progress::Progress;
@@ -50,23 +50,9 @@ pub struct GltfArgs {
     #[arg(long, value_name = "FILE.glb")]
     pub out: PathBuf,
 
-    /// Simulated time to run, in seconds (s); overrides the scene's `duration`.
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = number)]
-    pub duration: Option<Real>,
-
-    /// Number of steps of dt to take, instead of --duration.
-    #[arg(
-        long,
-        value_name = "N",
-        conflicts_with = "duration",
-        allow_negative_numbers = true,
-        value_parser = |t: &str| whole(t, 0, MAX_STEPS)
-    )]
-    pub steps: Option<u64>,
-
-    /// Time step, in seconds (s); overrides the scene's `dt`. Must be > 0.
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = number)]
-    pub dt: Option<Real>,
+    /// --duration, --steps, --dt.
+    #[command(flatten)]
+    pub span: Span,
 
     /// Keyframe every K-th step; step 0 and the last step are always keyframed (and, when
     /// a step fails, the last good one), as `tumble run --every` records them.
@@ -131,11 +117,7 @@ pub fn export(args: &GltfArgs) -> Result<(), Failure> {
             .set_threads(n)
             .map_err(|e| Failure::Input(e.to_string()))?;
     }
-    let dt = args.dt.unwrap_or(scene.dt);
-    let plan = match args.steps {
-        Some(steps) => RunPlan::from_steps(steps, dt),
-        None => RunPlan::from_duration(args.duration.unwrap_or(scene.duration), dt),
-    }?;
+    let plan = args.span.plan(&scene)?;
     let moving = scene
         .world
         .bodies()

@@ -4,9 +4,9 @@ use std::path::PathBuf;
 
 use clap::Args;
 use tumble::{Real, World};
-use tumble_scene::{RunPlan, Scene, SceneError, MAX_PASSES, MAX_STEPS};
+use tumble_scene::{RunPlan, Scene, MAX_PASSES};
 
-use crate::args::{number, whole, whole_u32};
+use crate::args::{whole, whole_u32, Span};
 use crate::output::{check_distinct, inputs, scene_file, Target, Writer};
 use crate::record::{
     CsvFile, CONTACT_IMPULSES_HEADER, DIAGNOSTICS_HEADER, JOINT_REACTIONS_HEADER,
@@ -31,23 +31,9 @@ pub struct RunArgs {
     #[arg(value_name = "SCENE")]
     pub scene: Option<String>,
 
-    /// Simulated time to run, in seconds (s); overrides the scene's `duration`.
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = number)]
-    pub duration: Option<Real>,
-
-    /// Number of steps of dt to take, instead of --duration.
-    #[arg(
-        long,
-        value_name = "N",
-        conflicts_with = "duration",
-        allow_negative_numbers = true,
-        value_parser = |t: &str| whole(t, 0, MAX_STEPS)
-    )]
-    pub steps: Option<u64>,
-
-    /// Time step, in seconds (s); overrides the scene's `dt`. Must be > 0.
-    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = number)]
-    pub dt: Option<Real>,
+    /// --duration, --steps, --dt.
+    #[command(flatten)]
+    pub span: Span,
 
     /// Integration method; overrides the scene's `integrator`. One of: explicit_euler,
     /// symplectic_euler, implicit_euler, midpoint, rk4, verlet, velocity_verlet.
@@ -134,9 +120,7 @@ impl Default for RunArgs {
     fn default() -> Self {
         RunArgs {
             scene: None,
-            duration: None,
-            steps: None,
-            dt: None,
+            span: Span::default(),
             integrator: None,
             out: None,
             diagnostics: None,
@@ -181,7 +165,7 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
                 .into(),
         ));
     }
-    let plan = plan(args, &scene)?;
+    let plan = args.span.plan(&scene)?;
     let times = Times::new(plan, scene.world.step_count());
     let mut sinks = Sinks::open(args, &scene, &plan)?;
     let mut progress = crate::progress::Progress::new(plan.steps, "running", args.quiet);
@@ -202,15 +186,6 @@ fn apply_solver_options(args: &RunArgs, world: &mut World) -> Result<(), Failure
     world
         .set_solver_settings(settings)
         .map_err(|e| Failure::Input(e.to_string()))
-}
-
-/// The command line's duration, steps and dt over the scene's.
-fn plan(args: &RunArgs, scene: &Scene) -> Result<RunPlan, SceneError> {
-    let dt = args.dt.unwrap_or(scene.dt);
-    match args.steps {
-        Some(steps) => RunPlan::from_steps(steps, dt),
-        None => RunPlan::from_duration(args.duration.unwrap_or(scene.duration), dt),
-    }
 }
 
 /// The times a run reports: k·dt after step k, counted from the start of the world's
