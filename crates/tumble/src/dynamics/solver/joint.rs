@@ -256,15 +256,16 @@ impl JointConstraint {
 
     /// The joint's frame at the bodies' poses in `sims`.
     pub fn frame(&self, sims: &[BodySim]) -> Frame {
-        let (sa, sb) = (Side::of(sims, self.a), Side::of(sims, self.b));
-        let (ra, rb) = (sa.q * self.anchor_a, sb.q * self.anchor_b);
-        Frame {
-            sa,
-            sb,
-            ra,
-            rb,
-            d: (sb.x + rb) - (sa.x + ra),
-        }
+        let side = Side::of(sims, None);
+        let mut fr = Frame {
+            sa: side,
+            sb: side,
+            ra: Vec3::ZERO,
+            rb: Vec3::ZERO,
+            d: Vec3::ZERO,
+        };
+        self.write_frame(sims, &mut fr);
+        fr
     }
 
     /// Overwrites `fr` with [`JointConstraint::frame`], field by field: returned whole, the
