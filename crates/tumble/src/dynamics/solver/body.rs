@@ -193,11 +193,7 @@ impl BodySim {
                 Mat3::from_diagonal(Vec3::new(0.0, 0.0, 1.0 / i)),
             )
         } else {
-            let r = Mat3::from_quat(m.q);
-            (
-                r * body.inertia_local * r.transpose(),
-                r * body.inv_inertia_local * r.transpose(),
-            )
+            world_inertia(body, m.q)
         };
         let sim = BodySim {
             x: m.x,
@@ -251,9 +247,7 @@ impl BodySim {
         if body.isotropic || body.planar {
             return;
         }
-        let r = Mat3::from_quat(self.q);
-        self.inertia = r * body.inertia_local * r.transpose();
-        self.inv_inertia = r * body.inv_inertia_local * r.transpose();
+        (self.inertia, self.inv_inertia) = world_inertia(body, self.q);
     }
 
     /// Impulses changed ω by I⁻¹ ΣΔL; the same ΣΔL goes into L: ΔL = I (ω − ω_synced).
@@ -267,4 +261,13 @@ impl BodySim {
             self.w_synced = state.w;
         }
     }
+}
+
+/// A body's world inertia and its inverse at orientation `q`: R I_body Rᵀ and R I_body⁻¹ Rᵀ.
+fn world_inertia(body: &Body, q: Quat) -> (Mat3, Mat3) {
+    let r = Mat3::from_quat(q);
+    (
+        r * body.inertia_local * r.transpose(),
+        r * body.inv_inertia_local * r.transpose(),
+    )
 }

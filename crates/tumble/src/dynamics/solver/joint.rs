@@ -226,7 +226,9 @@ impl JointConstraint {
         }
     }
 
-    /// Whether the joint has hard rows solved as one block (see `joint_rows.rs`).
+    /// Whether the joint has hard rows solved as one block (see `joint_rows.rs`): a kind
+    /// with none (a distance joint) skips the block solve, which would change nothing, and
+    /// a ball joint's point is solved apart.
     pub fn has_block(&self) -> bool {
         !self.point_apart()
             && (self.spec.linear != LinearLock::Free || self.spec.angular != AngularLock::Free)

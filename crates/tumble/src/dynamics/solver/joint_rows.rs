@@ -22,7 +22,7 @@ impl JointConstraint {
     /// The joint's equality rows (see the module's table); `None` when there are none to
     /// solve as a block.
     pub(super) fn hard_rows(&self, fr: &Frame) -> Option<HardRows> {
-        if self.point_apart() {
+        if !self.has_block() {
             return None;
         }
         let mut hard = HardRows::default();
@@ -60,9 +60,7 @@ impl JointConstraint {
             }
             AngularLock::Free => {}
         }
-        // A kind with no hard rows (a distance joint) skips the block solve, which would
-        // change nothing.
-        (hard.count > 0).then_some(hard)
+        Some(hard)
     }
 
     /// The joint's axis in the world, carried by body a (hinge, slider).
