@@ -1,7 +1,8 @@
 //! Issue 16: the benchmark scenes (the 385-cube pyramid, the rain of 2,000 balls and boxes
 //! into a walled box, the 30 × 30 joint grid) and the built-in ragdoll write the same
 //! trajectory, byte for byte, on 1, 2, 3 and 8 threads and in every lane mode of the
-//! contact passes (`TUMBLE_LANES`: AVX2 lanes, portable lanes, one manifold at a time).
+//! contact passes (`TUMBLE_LANES`: AVX-512 lanes, AVX2 lanes, portable lanes, one manifold at
+//! a time; AVX-512 falls back to AVX2 on a CPU without it).
 //!
 //! Each run is a whole `tumble run` process at the stages' real thresholds, so the splits a
 //! user's run takes are the ones checked (tests/threads.rs in the core crate forces every
@@ -168,7 +169,8 @@ fn benchmark_scenes_write_the_same_bytes_on_every_thread_count_and_lane_mode() {
             scene.display()
         );
         let runs = [
-            (2, "avx2"),
+            (1, "avx512"),
+            (2, "avx512"),
             (3, "avx2"),
             (8, "avx2"),
             (1, "portable"),

@@ -24,7 +24,7 @@ use std::ops::Range;
 
 use super::body::{BodyState, SharedStates, StateAccess};
 use super::contact::{ContactConstraint, Point, PointCold, Points, Row};
-use super::lanes::{lane_mode, LaneMode, Lanes, Lanes3, Mask, LANES};
+use super::lanes::{lane_mode, wide_kernel, LaneMode, Lanes, Lanes3, Mask, LANES};
 pub(crate) use super::rows::Pass;
 use super::rows::{self, Frame, Masks, Motion, Pair, Sums};
 use crate::team::Parts;
@@ -521,35 +521,16 @@ fn rotation<S: StateAccess + ?Sized>(states: &S, index: &[usize; LANES]) -> [Lan
     ]
 }
 
-/// Warm starts the contacts in `range`: the groups in lanes, the others one by one, all
-/// in the solver's order. No group straddles either end of `range`.
-pub(crate) fn warm_start(
-    constraints: &[ContactConstraint],
-    range: Range<usize>,
-    points: &Points,
-    states: &mut [BodyState],
-    par: Par,
-) {
-    #[cfg(target_arch = "x86_64")]
-    if super::lanes::use_avx2() {
-        // SAFETY: `use_avx2` has checked that this CPU supports AVX2, the only feature
-        // `warm_start_avx2` is compiled for; it has no other requirement.
-        unsafe { warm_start_avx2(constraints, range, points, states, par) };
-        return;
-    }
-    warm_start_lanes(constraints, range, points, states, par);
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn warm_start_avx2(
-    constraints: &[ContactConstraint],
-    range: Range<usize>,
-    points: &Points,
-    states: &mut [BodyState],
-    par: Par,
-) {
-    warm_start_lanes(constraints, range, points, states, par);
+wide_kernel! {
+    /// Warm starts the contacts in `range`: the groups in lanes, the others one by one, all
+    /// in the solver's order. No group straddles either end of `range`.
+    pub(crate) fn warm_start(
+        constraints: &[ContactConstraint],
+        range: Range<usize>,
+        points: &Points,
+        states: &mut [BodyState],
+        par: Par,
+    ) => warm_start_lanes
 }
 
 #[inline(always)]
@@ -666,55 +647,27 @@ fn solve_run<const BIAS: bool>(
     crate::team::pieces(threads, pieces, &work);
 }
 
-/// `each` over a piece of a run, compiled for AVX2 when the lanes use it (the closure,
-/// generic here, is inlined into the AVX2 function).
+wide_kernel! {
+    /// `each` over a piece of a run, compiled for the lane mode's instruction set (the
+    /// closure, generic here, is inlined into the wide kernel).
+    fn groups_leaf<F: FnMut(&Group)>(groups: &[Group], each: F) => each_group
+}
+
 #[inline(always)]
-fn groups_leaf<F: FnMut(&Group)>(groups: &[Group], each: F) {
-    #[cfg(target_arch = "x86_64")]
-    if super::lanes::use_avx2() {
-        // SAFETY: `use_avx2` has checked that this CPU supports AVX2, the only feature
-        // `groups_leaf_avx2` is compiled for; it has no other requirement.
-        unsafe { groups_leaf_avx2(groups, each) };
-        return;
-    }
+fn each_group<F: FnMut(&Group)>(groups: &[Group], each: F) {
     groups.iter().for_each(each);
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn groups_leaf_avx2<F: FnMut(&Group)>(groups: &[Group], each: F) {
-    groups.iter().for_each(each);
-}
-
-/// One solve or relax pass over the contacts in `range`: the groups in lanes, the others
-/// one by one, all in the solver's order. No group straddles either end of `range`.
-pub(crate) fn solve_pass(
-    constraints: &[ContactConstraint],
-    range: Range<usize>,
-    points: &mut Points,
-    states: &mut [BodyState],
-    (pass, par): (Pass<'_>, Par),
-) {
-    #[cfg(target_arch = "x86_64")]
-    if super::lanes::use_avx2() {
-        // SAFETY: `use_avx2` has checked that this CPU supports AVX2, the only feature
-        // `solve_pass_avx2` is compiled for; it has no other requirement.
-        unsafe { solve_pass_avx2(constraints, range, points, states, (pass, par)) };
-        return;
-    }
-    solve_pass_lanes(constraints, range, points, states, (pass, par));
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn solve_pass_avx2(
-    constraints: &[ContactConstraint],
-    range: Range<usize>,
-    points: &mut Points,
-    states: &mut [BodyState],
-    (pass, par): (Pass<'_>, Par),
-) {
-    solve_pass_lanes(constraints, range, points, states, (pass, par));
+wide_kernel! {
+    /// One solve or relax pass over the contacts in `range`: the groups in lanes, the others
+    /// one by one, all in the solver's order. No group straddles either end of `range`.
+    pub(crate) fn solve_pass(
+        constraints: &[ContactConstraint],
+        range: Range<usize>,
+        points: &mut Points,
+        states: &mut [BodyState],
+        pass_par: (Pass<'_>, Par),
+    ) => solve_pass_lanes
 }
 
 #[inline(always)]
@@ -977,6 +930,7 @@ mod tests {
             let scalar = run(LaneMode::Scalar, scene);
             assert_eq!(run(LaneMode::Portable, scene), scalar);
             assert_eq!(run(LaneMode::Avx2, scene), scalar);
+            assert_eq!(run(LaneMode::Avx512, scene), scalar);
         }
     }
 }
