@@ -21,25 +21,34 @@ use crate::collision::shape::Convex;
 use crate::collision::shape::Shape;
 use crate::dynamics::body::{Body, BodyKind};
 use crate::math::{Real, Vec3};
+use crate::threads::Par;
+
+/// Contacts a piece of [`find_ghosts`] looks at on the step's team. Most contacts cost a
+/// few dot products, the ones swept some µs; a thousand of the rain's is about 0.1–0.5 ms.
+const CONTACTS_A_PIECE: usize = 512;
 
 /// Marks in `ghost` the contacts whose speculative points the bodies will not reach within
 /// `horizon` (true = leave out of the solver). The horizon is the step plus one substep:
 /// the last relax pass runs after the last drift and already limits the closing speed
-/// for the substep after it.
+/// for the substep after it. Each contact's answer is its own, so pieces of the list go to
+/// the step's team (1 ms of the rain's 13 ms step on one thread).
 pub(crate) fn find_ghosts(
     bodies: &[Body],
     contacts: &[Contact],
-    gravity: Vec3,
-    horizon: Real,
-    slop: Real,
+    (gravity, horizon, slop): (Vec3, Real, Real),
     ghost: &mut Vec<bool>,
+    par: Par,
 ) {
     ghost.clear();
-    ghost.extend(
-        contacts
-            .iter()
-            .map(|c| is_ghost(bodies, c, gravity, horizon, slop)),
-    );
+    ghost.resize(contacts.len(), false);
+    let size = contacts
+        .len()
+        .div_ceil(par.pieces(contacts.len(), CONTACTS_A_PIECE));
+    crate::team::chunks(par.threads, ghost, size, &|start, part| {
+        for (k, g) in part.iter_mut().enumerate() {
+            *g = is_ghost(bodies, &contacts[start + k], gravity, horizon, slop);
+        }
+    });
 }
 
 fn is_ghost(bodies: &[Body], c: &Contact, gravity: Vec3, dt: Real, slop: Real) -> bool {

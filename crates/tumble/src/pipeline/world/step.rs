@@ -167,10 +167,13 @@ impl World {
         crate::pipeline::speculative::find_ghosts(
             &self.bodies.list,
             self.collision.contacts.contacts(),
-            self.settings.gravity,
-            time.dt * (1.0 + 1.0 / time.substeps as Real),
-            self.settings.tolerances.scales.linear_slop,
+            (
+                self.settings.gravity,
+                time.dt * (1.0 + 1.0 / time.substeps as Real),
+                self.settings.tolerances.scales.linear_slop,
+            ),
             &mut self.scratch.ghosts,
+            self.scratch.par,
         );
     }
 
