@@ -253,12 +253,6 @@ impl Lanes3 {
         r
     }
 
-    /// Sets lane `l` to `v`.
-    #[inline(always)]
-    pub fn set_lane(&mut self, l: usize, v: Vec3) {
-        (self.x.0[l], self.y.0[l], self.z.0[l]) = (v.x, v.y, v.z);
-    }
-
     /// The vector of lane `l`.
     #[inline(always)]
     pub fn lane(&self, l: usize) -> Vec3 {
