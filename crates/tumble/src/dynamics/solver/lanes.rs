@@ -3,12 +3,12 @@
 //!
 //! Every operation is a plain loop over the lanes applying the very operation the scalar
 //! code applies (`+`, `*`, `f64::max`, `sqrt`...), so each lane's result is bit for bit
-//! the scalar one; LLVM turns the loops into vector instructions (two SSE2 ones per f64
-//! operation in a baseline build, one AVX2 one in a function compiled for AVX2, half an
-//! AVX-512 one in a function compiled for AVX-512). There is
-//! no fused multiply–add and no reassociation: callers keep the scalar code's expression
-//! order. Comparisons give a [`Mask`] of all-ones or all-zeros lanes, and branches of the
-//! scalar code become [`Mask::select`]s between both outcomes.
+//! the scalar one; LLVM turns the loops into vector instructions (an operation on eight
+//! f64 lanes is four SSE2 instructions in a baseline build, two in a function compiled for
+//! AVX2, one in a function compiled for AVX-512). There is no fused multiply–add and no
+//! reassociation: callers keep the scalar code's expression order. Comparisons give a
+//! [`Mask`] of all-ones or all-zeros lanes, and branches of the scalar code become
+//! [`Mask::select`]s between both outcomes.
 
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
@@ -17,7 +17,9 @@ use crate::math::{Real, Vec3};
 
 /// Number of lanes. A group's updates form one dependent chain through its bodies'
 /// velocities, so lanes are what keeps the processor busy: 8 (two AVX2 registers of f64,
-/// one of f32) measured clearly faster than 4 on the pyramid, 16 slower (spills).
+/// one of f32) measured clearly faster than 4 on the pyramid, 16 slower (spills). With
+/// AVX-512, 16 f32 lanes (one register) were no faster than 8 (4 Dec: pyramid about the
+/// same, the rain slower).
 pub(crate) const LANES: usize = 8;
 
 /// The unsigned integer as wide as `Real`, for masks.
