@@ -151,9 +151,9 @@ pub(crate) struct Points {
 }
 
 impl Points {
-    pub fn clear(&mut self) {
-        self.hot.clear();
-        self.cold.clear();
+    /// Forgets the lane groups and the angular rows; the points keep their lists, which
+    /// `Solver::prepare` sizes and overwrites.
+    pub fn clear_rows(&mut self) {
         self.lanes.clear();
         self.angular.clear();
     }

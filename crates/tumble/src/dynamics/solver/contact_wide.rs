@@ -23,10 +23,11 @@
 use std::ops::Range;
 
 use super::body::{BodyState, SharedStates, StateAccess};
-use super::contact::{ContactConstraint, Point, PointCold, Points, Row};
+use super::contact::{ContactConstraint, Point, PointCold, Points};
 use super::lanes::{lane_mode, wide_kernel, LaneMode, Lanes, Lanes3, Mask, LANES};
 pub(crate) use super::rows::Pass;
 use super::rows::{self, Frame, Masks, Motion, Pair, Sums};
+use crate::math::Real;
 use crate::team::Parts;
 use crate::threads::Par;
 
@@ -275,96 +276,81 @@ impl ContactLanes {
 }
 
 /// Copies the points of a group's constraints `cs` into its slots: lane l of slot j is
-/// point j of constraint l; lanes without one are zero, and masked out. Each slot is made
-/// whole from its lanes' points and written once: blanking the slots and then writing
-/// them lane by lane moved every slot's two kilobytes twice (the blanking alone was 1.6 %
-/// of the rain's step).
+/// point j of constraint l; lanes without one are zero, and masked out. Each lane's point
+/// is stored field by field straight into its slot ([`Point::<Lanes>::set_lane`]): built
+/// through `array::from_fn` per field, with an `Option` tested per field and lane, the
+/// copy was 17 % of the pyramid's step, more than preparing the points themselves.
 fn fill_slots(
     cs: &[ContactConstraint],
     (hot, cold): (&[Point], &[PointCold]),
     (slots, masks): (&mut [Point<Lanes>], &mut [Masks<Mask>]),
     sums: &mut [Sums<Lanes>],
 ) {
-    let ranges: [Range<usize>; LANES] =
-        std::array::from_fn(|l| cs.get(l).map_or(0..0, ContactConstraint::range));
-    let moves: [(bool, bool); LANES] =
-        std::array::from_fn(|l| cs.get(l).map_or((false, false), ContactConstraint::moves));
+    let (zero, zero_sums) = (Point::default(), Sums::default());
     let slots = slots.iter_mut().zip(masks).zip(sums);
     for (j, ((slot, mask), sum)) in slots.enumerate() {
-        let at: [Option<usize>; LANES] = std::array::from_fn(|l| {
-            let i = ranges[l].start + j;
-            (i < ranges[l].end).then_some(i)
-        });
-        *slot = Point::<Lanes>::from_lanes(|l| at[l].map(|i| &hot[i]));
-        *sum = Sums::<Lanes>::from_lanes(|l| at[l].map(|i| &cold[i].sums));
         let mut m = Masks::<Mask>::default();
-        for (l, at) in at.iter().enumerate() {
-            if at.is_some() {
-                m.set_lane(l, moves[l]);
+        for l in 0..LANES {
+            let c = cs.get(l).filter(|c| j < c.range().len());
+            let i = c.map(|c| c.range().start + j);
+            slot.set_lane(l, i.map_or(&zero, |i| &hot[i]));
+            sum.set_lane(l, i.map_or(&zero_sums, |i| &cold[i].sums));
+            if let Some(c) = c {
+                m.set_lane(l, c.moves());
             }
         }
         *mask = m;
     }
 }
 
-impl Row<Lanes> {
-    /// Lane l is `row(l)`'s, or zero where there is none.
-    #[inline(always)]
-    fn from_lanes<'a>(row: impl Fn(usize) -> Option<&'a Row>) -> Row<Lanes> {
-        let v3 = |f: fn(&Row) -> crate::math::Vec3| {
-            Lanes3::from_fn(|l| row(l).map_or(crate::math::Vec3::ZERO, f))
-        };
-        Row {
-            turn_a: v3(|r| r.turn_a),
-            turn_b: v3(|r| r.turn_b),
-            mass: Lanes::from_fn(|l| row(l).map_or(0.0, |r| r.mass)),
-        }
-    }
+/// Calls `$m` with the path of every `Real` of a [`Point`] (in `Point<Lanes>` the same
+/// path names that real's lanes).
+macro_rules! point_reals {
+    ($m:ident) => {
+        $m!((ra.x)(ra.y)(ra.z)(rb.x)(rb.y)(rb.z)(separation)(lever)(
+            normal.turn_a.x
+        )(normal.turn_a.y)(normal.turn_a.z)(normal.turn_b.x)(
+            normal.turn_b.y
+        )(normal.turn_b.z)(normal.mass)(tangent[0].turn_a.x)(
+            tangent[0].turn_a.y
+        )(tangent[0].turn_a.z)(tangent[0].turn_b.x)(
+            tangent[0].turn_b.y
+        )(tangent[0].turn_b.z)(tangent[0].mass)(
+            tangent[1].turn_a.x
+        )(tangent[1].turn_a.y)(tangent[1].turn_a.z)(
+            tangent[1].turn_b.x
+        )(tangent[1].turn_b.y)(tangent[1].turn_b.z)(
+            tangent[1].mass
+        )(normal_impulse)(tangent_impulse[0])(tangent_impulse[1])(
+            max_normal_impulse
+        )(anchor_gap[0])(anchor_gap[1])(tangent_lever[0])(
+            tangent_lever[1]
+        ))
+    };
 }
 
+/// `point_reals!` names every field: a field added to `Point` must be added there.
+const _: () = assert!(std::mem::size_of::<Point>() == 37 * std::mem::size_of::<Real>());
+
 impl Point<Lanes> {
-    /// Lane l is `point(l)`, or zero where there is none.
+    /// Lane `l` becomes `p`.
     #[inline(always)]
-    fn from_lanes<'a>(point: impl Fn(usize) -> Option<&'a Point>) -> Point<Lanes> {
-        let one = |f: fn(&Point) -> crate::math::Real| Lanes::from_fn(|l| point(l).map_or(0.0, f));
-        let v3 = |f: fn(&Point) -> crate::math::Vec3| {
-            Lanes3::from_fn(|l| point(l).map_or(crate::math::Vec3::ZERO, f))
-        };
-        let row = |k: usize| {
-            Row::<Lanes>::from_lanes(|l| {
-                point(l).map(|p| match k {
-                    0 => &p.normal,
-                    1 => &p.tangent[0],
-                    _ => &p.tangent[1],
-                })
-            })
-        };
-        Point {
-            ra: v3(|p| p.ra),
-            rb: v3(|p| p.rb),
-            separation: one(|p| p.separation),
-            lever: one(|p| p.lever),
-            normal: row(0),
-            tangent: [row(1), row(2)],
-            normal_impulse: one(|p| p.normal_impulse),
-            tangent_impulse: [one(|p| p.tangent_impulse[0]), one(|p| p.tangent_impulse[1])],
-            max_normal_impulse: one(|p| p.max_normal_impulse),
-            anchor_gap: [one(|p| p.anchor_gap[0]), one(|p| p.anchor_gap[1])],
-            tangent_lever: [one(|p| p.tangent_lever[0]), one(|p| p.tangent_lever[1])],
+    fn set_lane(&mut self, l: usize, p: &Point) {
+        macro_rules! copy {
+            ($(($($f:tt)*))*) => { $( self.$($f)*.0[l] = p.$($f)*; )* };
         }
+        point_reals!(copy);
     }
 }
 
 impl Sums<Lanes> {
-    /// Lane l is `sums(l)`, or zero where there is none.
+    /// Lane `l` becomes `s`.
     #[inline(always)]
-    fn from_lanes<'a>(sums: impl Fn(usize) -> Option<&'a Sums>) -> Sums<Lanes> {
-        let one = |f: fn(&Sums) -> crate::math::Real| Lanes::from_fn(|l| sums(l).map_or(0.0, f));
-        Sums {
-            approach_velocity: one(|c| c.approach_velocity),
-            total_normal: one(|c| c.total_normal),
-            total_tangent: [one(|c| c.total_tangent[0]), one(|c| c.total_tangent[1])],
-        }
+    fn set_lane(&mut self, l: usize, s: &Sums) {
+        self.approach_velocity.0[l] = s.approach_velocity;
+        self.total_normal.0[l] = s.total_normal;
+        self.total_tangent[0].0[l] = s.total_tangent[0];
+        self.total_tangent[1].0[l] = s.total_tangent[1];
     }
 }
 

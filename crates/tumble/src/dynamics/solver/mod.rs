@@ -205,6 +205,9 @@ impl Solver {
     /// it is still being pushed out of an overlap.
     fn store_contacts(&self, contacts: &mut [Contact]) {
         for (k, c) in self.constraints.iter().enumerate() {
+            if let Some(ahead) = self.constraints.get(k + PREFETCH_AHEAD) {
+                crate::math::prefetch(&contacts[ahead.contact].manifold);
+            }
             let m = &mut contacts[c.contact].manifold;
             m.fine = if k >= self.tall_contacts {
                 self.fine
@@ -476,8 +479,7 @@ impl Solver {
         ghosts: &[bool],
         (slop, gravity, allow, spring): (Real, Vec3, overlap::Allowance, LoadSpring),
     ) {
-        self.constraints.clear();
-        self.points.clear();
+        self.points.clear_rows();
         self.deep.clear();
         let order = self.colour_order(&bodies.sims, contacts, ghosts);
         self.heavy_contacts = order.partition_point(|&(part, _, _)| part < Part::Heavy as u8);
@@ -491,10 +493,12 @@ impl Solver {
             total += contacts[i].manifold.len();
         }
         firsts.push(total);
-        self.constraints
-            .resize(order.len(), ContactConstraint::default());
-        self.points.hot.resize(total, Default::default());
-        self.points.cold.resize(total, Default::default());
+        // Every entry is overwritten whole below, so only a list's growth is written
+        // now (cleared and refilled with defaults, the lists' writes were 4 % of the
+        // pyramid's step).
+        set_len(&mut self.constraints, order.len());
+        set_len(&mut self.points.hot, total);
+        set_len(&mut self.points.cold, total);
         let sims = &bodies.sims;
         let with = PrepareWith {
             bodies: (bodies, world_bodies),
@@ -850,6 +854,11 @@ impl PrepareWith<'_> {
         let (bodies, _) = self.bodies;
         let base = self.firsts[range.start];
         for (k, c_out) in range.zip(cs) {
+            // The order jumps through the contacts: fetch a few ahead (waiting for the
+            // manifolds was a fifth of the preparation's time on the pyramid).
+            if let Some(&(_, _, ahead)) = self.order.get(k + PREFETCH_AHEAD) {
+                crate::math::prefetch(&self.contacts.0[ahead].manifold);
+            }
             let (_, colour, i) = self.order[k];
             let c = &self.contacts.0[i];
             let at = self.firsts[k] - base..self.firsts[k + 1] - base;
@@ -905,6 +914,17 @@ impl PrepareWith<'_> {
                 .then(|| (falls(sa), falls(sb))),
         }
     }
+}
+
+/// How many constraints ahead `PrepareWith::piece` and `store_contacts` fetch the
+/// contacts.
+const PREFETCH_AHEAD: usize = 4;
+
+/// Gives `v` length `n`, writing defaults only into entries it did not have: for lists
+/// whose every entry the caller then overwrites.
+fn set_len<T: Default + Clone>(v: &mut Vec<T>, n: usize) {
+    v.truncate(n);
+    v.resize(n, T::default());
 }
 
 /// x += h v and the exact torque-free rotation with L for a body the solver moves; a
