@@ -484,28 +484,6 @@ impl ContactConstraint {
         self.moves
     }
 
-    pub fn normal(&self) -> Vec3 {
-        self.frame.normal
-    }
-
-    pub fn tangents(&self) -> [Vec3; 2] {
-        self.frame.tangents
-    }
-
-    /// M⁻¹ d of each body for d = n, t₁, t₂.
-    pub fn pushes(&self) -> ([Vec3; 3], [Vec3; 3]) {
-        (self.frame.push_a, self.frame.push_b)
-    }
-
-    pub fn friction(&self) -> Real {
-        self.frame.friction
-    }
-
-    /// Each side's round radius along the normal (see `rows::Moved::normal`).
-    pub fn round(&self) -> [Real; 2] {
-        self.frame.round
-    }
-
     /// Whether a side of the manifold is round.
     pub fn has_round(&self) -> bool {
         self.frame.round[0] + self.frame.round[1] > 0.0

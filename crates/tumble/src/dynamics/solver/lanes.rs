@@ -45,12 +45,6 @@ impl Lanes {
         Lanes([x; LANES])
     }
 
-    /// Lane `l` is `f(l)`: gathers one value per lane.
-    #[inline(always)]
-    pub fn from_fn(f: impl FnMut(usize) -> Real) -> Lanes {
-        Lanes(std::array::from_fn(f))
-    }
-
     #[inline(always)]
     fn map2(self, rhs: Lanes, f: impl Fn(Real, Real) -> Real) -> Lanes {
         let mut r = self.0;
@@ -232,17 +226,6 @@ pub(crate) struct Lanes3 {
 }
 
 impl Lanes3 {
-    /// Lane `l` is `f(l)`: gathers one vector per lane.
-    #[inline(always)]
-    pub fn from_fn(mut f: impl FnMut(usize) -> Vec3) -> Lanes3 {
-        let v: [Vec3; LANES] = std::array::from_fn(&mut f);
-        Lanes3 {
-            x: Lanes::from_fn(|l| v[l].x),
-            y: Lanes::from_fn(|l| v[l].y),
-            z: Lanes::from_fn(|l| v[l].z),
-        }
-    }
-
     /// Lane `l` is `field(index[l])`: written as a loop, which the compiler inlines into
     /// the kernels, where a closure per lane was left as a call.
     #[inline(always)]
