@@ -24,6 +24,7 @@ pub(super) fn point_impulse(imp: &JointImpulses) -> Vec3 {
 }
 
 /// Applies a linear impulse `p` at the anchors: −p on `body`, +p on `other`.
+#[inline(always)]
 pub(super) fn apply_point(p: Vec3, fr: &Frame, a: &mut BodyState, b: &mut BodyState) {
     if fr.sa.moves {
         a.v -= fr.sa.mask * p * fr.sa.inv_mass;
