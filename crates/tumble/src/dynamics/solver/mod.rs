@@ -732,11 +732,29 @@ impl Solver {
         // lane groups (see `contact_wide`) carry few empty points. (Ordering a colour by
         // blocks of bodies first, so that each thread's share of every colour writes the
         // same bodies, made the rain no faster on two threads and slower on one.)
+        // Sorted as packed integers, each key (part, colour, size, i) made once: compared
+        // as tuples, the sort read each manifold's size again at every comparison, in an
+        // order that jumps through the contacts (2 % of the pyramid's step).
+        // (An index fits in 32 bits: four billion contacts would take terabytes.)
         let size = |colour: u32, i: usize| match colour {
             63 => 0,
-            _ => contacts[i].manifold.len(),
+            _ => contacts[i].manifold.len() as u64,
         };
-        coloured.sort_unstable_by_key(|&(part, colour, i)| (part, colour, size(colour, i), i));
+        let mut keys: Vec<u64> = coloured
+            .iter()
+            .map(|&(part, colour, i)| {
+                (u64::from(part) << 48)
+                    | (u64::from(colour) << 40)
+                    | (size(colour, i) << 32)
+                    | i as u64
+            })
+            .collect();
+        keys.sort_unstable();
+        coloured.clear();
+        coloured.extend(keys.iter().map(|&k| {
+            let (part, colour) = ((k >> 48) as u8, ((k >> 40) & 0xff) as u32);
+            (part, colour, (k & 0xffff_ffff) as usize)
+        }));
         coloured
     }
 
