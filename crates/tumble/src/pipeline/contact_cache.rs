@@ -309,8 +309,10 @@ fn reuse_previous(
     let contact = contacts.last_mut().expect("just pushed");
     (contact.index_a, contact.index_b) = (a as u32, b as u32);
     contact.basis.place(&mut contact.manifold, pa, pb);
-    // Matches each point to itself, but re-anchors the ones that slid.
-    warm_start(contact, old, (pa, pb));
+    // Matches each point to itself, but re-anchors the ones that slid. The old contact is
+    // `c` itself: looked up again by the copy's key, the lookup waited for the copy's
+    // stores (half of `warm_start`'s time in the rain).
+    warm_start(contact, Some(c), (pa, pb));
     true
 }
 
@@ -410,7 +412,8 @@ fn push_new(
             edited: false,
         });
         let contact = contacts.last_mut().expect("just pushed");
-        warm_start(contact, old, (pa, pb));
+        let before = old.find(contact.key());
+        warm_start(contact, before, (pa, pb));
     }
 }
 
@@ -842,18 +845,19 @@ fn keep_previous(
     }
 }
 
-/// Copies last step's impulses onto this step's points: by feature id, or, for a point
+/// Copies last step's impulses onto this step's points from `previous`, last step's
+/// contact of the same key if there was one: by feature id, or, for a point
 /// whose features were renamed (a pair routine may pick the other box's face as reference
 /// from one step to the next), by proximity — the old point within `MATCH_DISTANCE` of it.
 /// Losing warm starts on a resting stack would restart its solution from zero each time.
-fn warm_start(contact: &mut Contact, previous: &Sorted<'_>, poses: (&Pose, &Pose)) {
+fn warm_start(contact: &mut Contact, previous: Option<&Contact>, poses: (&Pose, &Pose)) {
     let anchor_here = |p: &mut crate::collision::narrow_phase::ContactPoint| {
         let mid = (p.point_a + p.point_b) * 0.5;
         p.anchor_a = poses.0.inverse_transform_point(mid);
         p.anchor_b = poses.1.inverse_transform_point(mid);
         p.anchored = true;
     };
-    let Some(old) = previous.find(contact.key()) else {
+    let Some(old) = previous else {
         contact
             .manifold
             .points_mut()
