@@ -59,9 +59,19 @@ struct Side {
 }
 
 impl Side {
-    /// Overwrites the side with [`Side::of`], field by field: built on the stack and
-    /// copied, its fields were stored narrow and loaded wide, and the loads waited on the
-    /// stores (a quarter of `write_frame`'s time on the joint grid).
+    /// The world's side: never moves, at the origin.
+    const WORLD: Side = Side {
+        x: Vec3::ZERO,
+        q: Quat::IDENTITY,
+        inv_mass: 0.0,
+        mask: Vec3::ZERO,
+        inv_inertia: Mat3::ZERO,
+        moves: false,
+    };
+
+    /// Overwrites the side with body `k`'s (`None`: the world's), field by field: built on
+    /// the stack and copied, its fields were stored narrow and loaded wide, and the loads
+    /// waited on the stores (a quarter of `write_frame`'s time on the joint grid).
     fn write(&mut self, sims: &[BodySim], k: Option<usize>) {
         match k.map(|k| &sims[k]) {
             Some(s) => {
@@ -72,28 +82,7 @@ impl Side {
                 self.inv_inertia = s.inv_inertia;
                 self.moves = s.moves;
             }
-            None => *self = Side::of(sims, None),
-        }
-    }
-
-    fn of(sims: &[BodySim], k: Option<usize>) -> Side {
-        match k.map(|k| &sims[k]) {
-            Some(s) => Side {
-                x: s.x,
-                q: s.q,
-                inv_mass: s.inv_mass,
-                mask: s.linear_mask,
-                inv_inertia: s.inv_inertia,
-                moves: s.moves,
-            },
-            None => Side {
-                x: Vec3::ZERO,
-                q: Quat::IDENTITY,
-                inv_mass: 0.0,
-                mask: Vec3::ZERO,
-                inv_inertia: Mat3::ZERO,
-                moves: false,
-            },
+            None => *self = Side::WORLD,
         }
     }
 }
@@ -275,10 +264,9 @@ impl JointConstraint {
 
     /// The joint's frame at the bodies' poses in `sims`.
     pub fn frame(&self, sims: &[BodySim]) -> Frame {
-        let side = Side::of(sims, None);
         let mut fr = Frame {
-            sa: side,
-            sb: side,
+            sa: Side::WORLD,
+            sb: Side::WORLD,
             ra: Vec3::ZERO,
             rb: Vec3::ZERO,
             d: Vec3::ZERO,
