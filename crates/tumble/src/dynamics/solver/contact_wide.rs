@@ -303,11 +303,14 @@ fn fill_slots(
     }
 }
 
-/// Calls `$m` with the path of every `Real` of a [`Point`] (in `Point<Lanes>` the same
-/// path names that real's lanes).
-macro_rules! point_reals {
-    ($m:ident) => {
-        $m!((ra.x)(ra.y)(ra.z)(rb.x)(rb.y)(rb.z)(separation)(lever)(
+impl Point<Lanes> {
+    /// Lane `l` becomes `p`, field by field.
+    #[inline(always)]
+    fn set_lane(&mut self, l: usize, p: &Point) {
+        macro_rules! copy {
+            ($(($($f:tt)*))*) => { $( self.$($f)*.0[l] = p.$($f)*; )* };
+        }
+        copy!((ra.x)(ra.y)(ra.z)(rb.x)(rb.y)(rb.z)(separation)(lever)(
             normal.turn_a.x
         )(normal.turn_a.y)(normal.turn_a.z)(normal.turn_b.x)(
             normal.turn_b.y
@@ -321,27 +324,16 @@ macro_rules! point_reals {
             tangent[1].turn_b.x
         )(tangent[1].turn_b.y)(tangent[1].turn_b.z)(
             tangent[1].mass
-        )(normal_impulse)(tangent_impulse[0])(tangent_impulse[1])(
-            max_normal_impulse
-        )(anchor_gap[0])(anchor_gap[1])(tangent_lever[0])(
-            tangent_lever[1]
-        ))
-    };
-}
-
-/// `point_reals!` names every field: a field added to `Point` must be added there.
-const _: () = assert!(std::mem::size_of::<Point>() == 37 * std::mem::size_of::<Real>());
-
-impl Point<Lanes> {
-    /// Lane `l` becomes `p`.
-    #[inline(always)]
-    fn set_lane(&mut self, l: usize, p: &Point) {
-        macro_rules! copy {
-            ($(($($f:tt)*))*) => { $( self.$($f)*.0[l] = p.$($f)*; )* };
-        }
-        point_reals!(copy);
+        )(normal_impulse)(tangent_impulse[0])(
+            tangent_impulse[1]
+        )(max_normal_impulse)(anchor_gap[0])(anchor_gap[1])(
+            tangent_lever[0]
+        )(tangent_lever[1]));
     }
 }
+
+/// `Point::set_lane` names every field: a field added to `Point` must be added there.
+const _: () = assert!(std::mem::size_of::<Point>() == 37 * std::mem::size_of::<Real>());
 
 impl Frame<Lanes> {
     /// Lane `l` becomes `f`, field by field (gathered through `array::from_fn` per field,
