@@ -177,12 +177,20 @@ impl Par {
 
     /// Into how many pieces to split `items` units of work of which a piece should have
     /// at least `least` (below that a piece's hand-off costs more than it saves): 1 when
-    /// serial or small, else up to four pieces a thread, so that uneven pieces even out.
+    /// serial or small, else a multiple of the thread count up to four pieces a thread,
+    /// so that uneven pieces even out. Not a multiple, equal pieces leave a thread idle
+    /// at the end: a graph colour of 100 lane groups in three pieces gave one of two
+    /// threads two of them (the rain's contact passes, 5 % faster on two threads split
+    /// in twos).
     pub fn pieces(&self, items: usize, least: usize) -> usize {
         if self.threads <= 1 {
             return 1;
         }
-        Par::split_at(items, least).clamp(1, 4 * self.threads)
+        let n = Par::split_at(items, least);
+        if n < self.threads {
+            return n.max(1);
+        }
+        (n / self.threads * self.threads).min(4 * self.threads)
     }
 }
 
@@ -204,7 +212,8 @@ mod tests {
     fn small_work_is_not_split() {
         let par = Par { threads: 4 };
         assert_eq!(par.pieces(10, 64), 1);
-        assert_eq!(par.pieces(640, 64), 10);
+        assert_eq!(par.pieces(640, 64), 8);
+        assert_eq!(par.pieces(192, 64), 3);
         assert_eq!(par.pieces(64_000, 64), 16);
         assert_eq!(Par::SERIAL.pieces(64_000, 64), 1);
     }
