@@ -12,6 +12,7 @@ use crate::id::BodyId;
 use crate::limits::{ContactLimits, MAX_MANIFOLDS_PER_PAIR};
 use crate::math::{Real, Vec3};
 use crate::threads::Par;
+use std::mem::MaybeUninit;
 
 /// Shapes whose pair yields at most one manifold with fixed sub-shapes (0, 0), so that a
 /// reused manifold stands for the whole pair.
@@ -343,6 +344,38 @@ const PAIRS_A_PIECE: usize = 256;
 const MOTIONS_A_PIECE: usize = 1024;
 
 /// The broad phase's caps for `limits` and the contact margin (m).
+/// Moves every piece's contacts, in piece order, into `into` (emptied first), each piece
+/// to its own place on the step's team. Appended one piece after another, the rain's
+/// 4,000 kilobyte-sized contacts took 0.44 ms of its 7.6 ms step on two threads, all on
+/// one of them.
+fn concat_pieces(into: &mut Vec<Contact>, pieces: &mut [(PairScratch, Vec<Contact>)], par: Par) {
+    let total: usize = pieces.iter().map(|(_, out)| out.len()).sum();
+    into.clear();
+    into.reserve(total);
+    let mut room = &mut into.spare_capacity_mut()[..total];
+    let mut moves: Vec<(&mut [MaybeUninit<Contact>], &mut Vec<Contact>)> =
+        Vec::with_capacity(pieces.len());
+    for (_, out) in pieces.iter_mut() {
+        let (mine, rest) = std::mem::take(&mut room).split_at_mut(out.len());
+        moves.push((mine, out));
+        room = rest;
+    }
+    crate::team::chunks(par.threads, &mut moves, 1, &|_, part| {
+        for (room, out) in part.iter_mut() {
+            for (slot, c) in room.iter_mut().zip(out.drain(..)) {
+                slot.write(c);
+            }
+        }
+    });
+    // SAFETY: the rooms split the first `total` slots of the buffer (`total` ≤ its
+    // capacity, reserved above) with no gap, each as long as its piece's list when it was
+    // split off, and every piece was drained whole into its room (equal lengths: `zip`
+    // stops at neither side early), so all `total` slots hold a contact written above. If
+    // a piece panicked, the panic passes through `chunks` before this line: the contacts
+    // already moved leak, and the list stays empty.
+    unsafe { into.set_len(total) };
+}
+
 fn crowding(limits: &ContactLimits, margin: Real) -> Crowding {
     Crowding {
         sunk: limits
@@ -587,10 +620,7 @@ impl ContactCache {
         self.collided = pieces.iter().map(|(s, _)| s.collided).sum();
         let fits = total < ENGAGE * world.bodies.len() && total <= limits.per_step as usize;
         if fits {
-            self.contacts.clear();
-            for (_, out) in &mut pieces {
-                self.contacts.append(out);
-            }
+            concat_pieces(&mut self.contacts, &mut pieces, par);
         }
         self.pieces = pieces;
         self.motions = motions;
