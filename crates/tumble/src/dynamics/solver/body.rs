@@ -10,6 +10,11 @@
 
 use crate::dynamics::body::{Body, BodyKind, Motion};
 use crate::math::{Mat3, Quat, Real, Vec3};
+use crate::threads::Par;
+
+/// Fewest bodies worth a piece of a per-body loop on another thread (a body's is some
+/// 50 ns: a piece of 256 is over ten times a hand-off's cost).
+pub(crate) const BODIES_A_PIECE: usize = 256;
 
 /// Every body of the world as the step sees it, in the world's dense order.
 #[derive(Default)]
@@ -21,14 +26,28 @@ pub(crate) struct SolverBodies {
 impl SolverBodies {
     /// Gathers every body at the step's start; `solved[i]` marks the bodies the solver
     /// will move (their world inertia is needed; the others' is left zero).
-    pub fn gather(&mut self, bodies: &[Body], solved: &[bool]) {
-        self.sims.clear();
-        self.states.clear();
-        for (b, &solved) in bodies.iter().zip(solved) {
-            let (sim, state) = BodySim::new(b, solved);
-            self.sims.push(sim);
-            self.states.push(state);
-        }
+    /// In pieces on the step's team: one after another it was 0.22 ms of the rain's
+    /// step on two threads (its world inertias are two rotations a body).
+    pub fn gather(&mut self, bodies: &[Body], solved: &[bool], par: Par) {
+        let n = bodies.len().min(solved.len());
+        let Some(first) = bodies.first().filter(|_| n > 0) else {
+            self.sims.clear();
+            self.states.clear();
+            return;
+        };
+        // Sized without a write to what is already there: every slot is set below.
+        let (sim, state) = BodySim::new(first, solved[0]);
+        self.sims.truncate(n);
+        self.sims.resize(n, sim);
+        self.states.truncate(n);
+        self.states.resize(n, state);
+        let size = n.div_ceil(par.pieces(n, BODIES_A_PIECE));
+        let pair = (&mut self.sims[..], &mut self.states[..]);
+        crate::team::chunks2(par.threads, pair, size, &|start, sims, states| {
+            for (j, (sim, state)) in sims.iter_mut().zip(states).enumerate() {
+                (*sim, *state) = BodySim::new(&bodies[start + j], solved[start + j]);
+            }
+        });
     }
 
     /// Body `i`'s state as the integrators' ODE vector sees it.

@@ -38,6 +38,7 @@ pub use settings::{SolverKind, SolverSettings};
 use softness::LoadSpring;
 pub use softness::Softness;
 
+use body::BODIES_A_PIECE;
 pub(crate) use body::{BodySim, BodyState, SolverBodies};
 use contact::{BiasRule, ContactConstraint, PairData, Points};
 use joint::{Block as JointBlock, Frame as JointFrame, JointConstraint, JointPass};
@@ -53,10 +54,6 @@ use crate::math::{Mat3, Real, Vec3};
 use crate::team::Parts;
 use crate::threads::Par;
 use std::ops::Range;
-
-/// Fewest bodies worth a piece of a kick or a drift on another thread (a body's is some
-/// 50 ns: a piece of 256 is over ten times a hand-off's cost).
-const BODIES_A_PIECE: usize = 256;
 
 /// What the solver needs of a step.
 pub(crate) struct StepInput<'a, 'b> {

@@ -158,7 +158,7 @@ impl World {
                 ctx.solved[i] = true;
             }
         }
-        ctx.bodies.gather(bodies, &ctx.solved);
+        ctx.bodies.gather(bodies, &ctx.solved, ctx.par);
     }
 
     /// Speculative contacts that the bodies' motion over the step and one substep more
