@@ -112,6 +112,8 @@ pub(crate) struct Solver {
     /// (see `overlap`), and scratch.
     deep: Vec<overlap::Deep>,
     overlap: overlap::Scratch,
+    /// Per contact, its constraint's index (`u32::MAX`: not solved), for `store_contacts`.
+    of_contact: Vec<u32>,
     /// How this step's passes may split their work.
     par: Par,
 }
@@ -199,21 +201,31 @@ impl Solver {
     }
 
     /// Writes back each solved contact's impulses, the rate it was solved at, and whether
-    /// it is still being pushed out of an overlap.
-    fn store_contacts(&self, contacts: &mut [Contact]) {
+    /// it is still being pushed out of an overlap. Walked in the contacts' order, in
+    /// pieces on the step's team: in colour order it jumped through the kilobyte-sized
+    /// contacts, all on one thread (0.19 ms of the rain's step on two).
+    fn store_contacts(&mut self, contacts: &mut [Contact]) {
+        let of_contact = &mut self.of_contact;
+        of_contact.clear();
+        of_contact.resize(contacts.len(), u32::MAX);
         for (k, c) in self.constraints.iter().enumerate() {
-            if let Some(ahead) = self.constraints.get(k + PREFETCH_AHEAD) {
-                crate::math::prefetch(&contacts[ahead.contact].manifold);
-            }
-            let m = &mut contacts[c.contact].manifold;
-            m.fine = if k >= self.tall_contacts {
-                self.fine
-            } else {
-                1
-            } as u8;
-            m.overlap = Overlap::Clear;
-            c.store_impulses(&self.points, &mut contacts[c.contact]);
+            of_contact[c.contact] = k as u32;
         }
+        let (of_contact, constraints, points) = (&self.of_contact, &self.constraints, &self.points);
+        let (tall_contacts, fine) = (self.tall_contacts, self.fine as u8);
+        let n = contacts.len();
+        let size = n.div_ceil(self.par.pieces(n, STORES_A_PIECE));
+        crate::team::chunks(self.par.threads, contacts, size, &|start, part| {
+            for (contact, &k) in part.iter_mut().zip(&of_contact[start..]) {
+                let Some(c) = constraints.get(k as usize) else {
+                    continue;
+                };
+                let m = &mut contact.manifold;
+                m.fine = if k as usize >= tall_contacts { fine } else { 1 };
+                m.overlap = Overlap::Clear;
+                c.store_impulses(points, contact);
+            }
+        });
         for d in self.deep.iter().filter(|d| !d.guard) {
             let c = &self.constraints[d.constraint as usize];
             contacts[c.contact].manifold.overlap = Overlap::Recovering;
@@ -839,6 +851,10 @@ impl Solver {
         self.per_body(solver_bodies, &work);
     }
 }
+
+/// Fewest contacts worth a piece of `store_contacts` on another thread (one is some
+/// 50 ns, a tenth of its preparation).
+const STORES_A_PIECE: usize = 512;
 
 /// Fewest constraints worth a piece of the preparation on another thread (one is some
 /// half a microsecond; a hand-off to the team about one).
