@@ -415,22 +415,45 @@ fn body(
     warnings: &mut Vec<String>,
 ) -> Result<PlannedBody> {
     let first = &model.links[group[0]];
+    let has_mass = group.iter().any(|&l| {
+        let link = &model.links[l];
+        link.inertial.as_ref().is_some_and(|i| i.mass > 0.0)
+    });
+    let is_static = is_root && (opts.fixed_base || !has_mass);
     let mut parts = Vec::new();
     for &l in group {
         let link = &model.links[l];
-        let Some(i) = link.inertial.filter(|i| i.mass > 0.0) else {
+        let Some(i) = link.inertial.as_ref().filter(|i| i.mass > 0.0) else {
             continue;
         };
-        let inertia = match i.inertia {
-            Some(tensor) => tensor,
-            None => {
+        let from_geometry = |meshes: &mut MeshCache| -> Result<tumble::Mat3> {
+            let alone = vec![Pose::IDENTITY; model.links.len()];
+            let (shape, _) = shape(model, &[l], &alone, false, meshes)?;
+            Ok(shape.mass_properties(1.0).with_mass(i.mass).inertia)
+        };
+        let inertia = match (i.inertia, &i.problem) {
+            // A static body's mass properties are never used: nothing to refuse.
+            (Some(_), Some(problem)) if is_static => {
+                warnings.push(format!(
+                    "{}: inertial.inertia: {problem}; not used (the link does not move)",
+                    link.at
+                ));
+                continue;
+            }
+            (Some(_), Some(problem)) => {
+                warnings.push(format!(
+                    "{}: inertial.inertia: {problem}; taken from the collision geometry at uniform density, as PyBullet does",
+                    link.at
+                ));
+                from_geometry(meshes)?
+            }
+            (Some(tensor), None) => tensor,
+            (None, _) => {
                 warnings.push(format!(
                     "{}: inertial.inertia: all zero; taken from the collision geometry at uniform density, as PyBullet does",
                     link.at
                 ));
-                let alone = vec![Pose::IDENTITY; model.links.len()];
-                let (shape, _) = shape(model, &[l], &alone, false, meshes)?;
-                shape.mass_properties(1.0).with_mass(i.mass).inertia
+                from_geometry(meshes)?
             }
         };
         let local = MassProperties {
@@ -440,7 +463,6 @@ fn body(
         };
         parts.push(local.transformed(offset[l].position, offset[l].rotation));
     }
-    let is_static = is_root && (opts.fixed_base || parts.is_empty());
     let (shape, has_geometry) = shape(model, group, offset, is_static, meshes)?;
     let mut def = BodyDef {
         name: Some(format!("{}{}", opts.prefix, first.name)),

@@ -50,12 +50,16 @@ pub(crate) struct Link {
 /// link frame (the `<origin>`'s rotation already applied: R I Rᵀ). `inertia` is `None`
 /// when the file gives a mass but an all-zero tensor (common in exported files, and
 /// ignored by PyBullet, which by default takes the tensor from the collision shapes):
-/// the builder then does the same and says so.
-#[derive(Debug, Clone, Copy)]
+/// the builder then does the same and says so. `problem` says why a tensor given with a
+/// mass > 0 is not a possible one (not positive definite, or a principal moment above
+/// the sum of the other two): the builder ignores it for a link that does not move, and
+/// takes a moving link's from its collision geometry, as PyBullet does, with a warning.
+#[derive(Debug, Clone)]
 pub(crate) struct Inertial {
     pub center: Vec3,
     pub mass: Real,
     pub inertia: Option<Mat3>,
+    pub problem: Option<String>,
 }
 
 /// One `<collision>`: its geometry placed in the link frame.
@@ -320,44 +324,14 @@ impl Cx<'_, '_> {
             }
             .with_mass(mass));
         }
-        if mass > 0.0 {
-            self.check_tensor(link, local)?;
-        }
+        let problem = (mass > 0.0).then(|| tensor_problem(local)).flatten();
         let r = Mat3::from_quat(origin.rotation);
         Ok(Inertial {
             center: origin.position,
             mass,
             inertia: Some(r * local * r.transpose()),
+            problem,
         })
-    }
-
-    /// Positive definite, and no principal moment above the sum of the other two (with
-    /// a relative slack of 1e-6 for files that round their moments to a few digits).
-    fn check_tensor(&self, link: Node<'_, '_>, m: Mat3) -> Result<()> {
-        let (moments, _) = symmetric_eigen(m);
-        let mut sorted = moments.to_array();
-        sorted.sort_by(Real::total_cmp);
-        let [a, b, c] = sorted.map(short);
-        let list = format!("principal moments [{a}, {b}, {c}]");
-        if moments.min_element() <= 0.0 {
-            return Err(self.err(
-                link,
-                "inertial.inertia",
-                format!("must be positive definite, but its {list}"),
-            ));
-        }
-        let sum = moments.x + moments.y + moments.z;
-        let largest = moments.max_element();
-        if largest > (sum - largest) * (1.0 + 1e-6) {
-            return Err(self.err(
-                link,
-                "inertial.inertia",
-                format!(
-                    "is impossible: of its {list} the largest exceeds the sum of the other two"
-                ),
-            ));
-        }
-        Ok(())
     }
 
     fn collision(&self, node: Node<'_, '_>) -> Result<Collision> {
@@ -535,7 +509,30 @@ fn zero_mass(origin: Pose) -> Inertial {
         center: origin.position,
         mass: 0.0,
         inertia: Some(Mat3::ZERO),
+        problem: None,
     }
+}
+
+/// Why `m` is not a possible inertia tensor, if it is not: it must be positive definite,
+/// with no principal moment above the sum of the other two (with a relative slack of
+/// 1e-6 for files that round their moments to a few digits).
+fn tensor_problem(m: Mat3) -> Option<String> {
+    let (moments, _) = symmetric_eigen(m);
+    let mut sorted = moments.to_array();
+    sorted.sort_by(Real::total_cmp);
+    let [a, b, c] = sorted.map(short);
+    let list = format!("principal moments [{a}, {b}, {c}]");
+    if moments.min_element() <= 0.0 {
+        return Some(format!("is not positive definite: its {list}"));
+    }
+    let sum = moments.x + moments.y + moments.z;
+    let largest = moments.max_element();
+    if largest > (sum - largest) * (1.0 + 1e-6) {
+        return Some(format!(
+            "is impossible: of its {list} the largest exceeds the sum of the other two"
+        ));
+    }
+    None
 }
 
 impl Inertial {
