@@ -52,6 +52,20 @@ pub fn read_mesh(path: &Path) -> Result<MeshData> {
     Ok(mesh)
 }
 
+/// The triangles of `triangles` that have an area, as `TriMesh::new` judges it: exported
+/// meshes often hold slivers (three corners on a line, or two the same), which add nothing
+/// to a static mesh's surface but which the engine's mesh refuses.
+pub(crate) fn with_area(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {
+    triangles
+        .iter()
+        .filter(|t| {
+            let [a, b, c] = t.map(|i| vertices[i as usize]);
+            tumble::TriMesh::has_area(a, b, c)
+        })
+        .copied()
+        .collect()
+}
+
 fn line_err(name: &str, line: usize, reason: impl Into<String>) -> SceneError {
     SceneError::new(format!("{name}:{line}"), reason)
 }

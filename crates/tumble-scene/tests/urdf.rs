@@ -968,3 +968,35 @@ fn an_impossible_inertia_is_unused_on_a_static_link_and_taken_from_the_geometry_
         assert!((a.mass() - 2.0).abs() < EXACT);
     }
 }
+
+#[test]
+fn pybullets_leniencies_trailing_nul_extra_numbers_and_sliver_triangles_are_read() {
+    let d = dir("lenient");
+    // PyBullet's humanoid.urdf ends in a NUL byte; its racecar_differential.urdf has
+    // scale="1 1 1 1" and microtaur.urdf rpy="-3.14159 1.57079 0 0" (the first 3 read).
+    write(&d, "box.obj", &box_obj());
+    let text = "<robot name=\"r\">\n<link name=\"a\">\n<collision><origin rpy=\"0 0 0 0\"/><geometry><mesh filename=\"box.obj\" scale=\"1 1 1 1\"/></geometry></collision>\n</link>\n</robot>\n\0";
+    let (w, m, shown) = warned(&d, "lenient.urdf", text, true);
+    assert_eq!(
+        shown,
+        [
+            "lenient.urdf:3: <origin>: origin.rpy: expected 3 numbers, got 4 ('0 0 0 0'); the first 3 used, as PyBullet does",
+            "lenient.urdf:3: <mesh>: scale: expected 3 numbers, got 4 ('1 1 1 1'); the first 3 used, as PyBullet does",
+        ]
+    );
+    assert!(matches!(
+        w.body(m.body("a").unwrap()).unwrap().shape(),
+        Shape::TriMesh(_)
+    ));
+    // A static mesh with a sliver (three corners on a line) and a repeated corner, as
+    // PyBullet's samurai.urdf has: the slivers are dropped, the 12 faces kept.
+    let sliver = box_obj() + "f 1 2 2\nv 0.1 0.2 0.3\nv 0.0 0.2 0.3\nf 8 9 10\n";
+    write(&d, "sliver.obj", &sliver);
+    let text = "<robot name=\"r\">\n<link name=\"a\">\n<collision><geometry><mesh filename=\"sliver.obj\"/></geometry></collision>\n</link>\n</robot>\n";
+    let (w, m, shown) = warned(&d, "sliver.urdf", text, true);
+    assert!(shown.is_empty(), "{shown:?}");
+    let Shape::TriMesh(mesh) = w.body(m.body("a").unwrap()).unwrap().shape() else {
+        panic!("not a mesh");
+    };
+    assert_eq!(mesh.len(), 12);
+}

@@ -402,17 +402,12 @@ fn check_volume(volume: Real, elem: &Elem) -> Result<()> {
 }
 
 /// A mesh's vertices and its triangles of non-zero area (a static mesh's, in the geom's
-/// frame).
+/// frame), by the test of `TriMesh::new`.
 pub(crate) fn nondegenerate(points: &[Vec3], triangles: &[[u32; 3]]) -> (Vec<Vec3>, Vec<[u32; 3]>) {
-    let kept = triangles
-        .iter()
-        .filter(|t| {
-            let [a, b, c] = t.map(|i| points[i as usize]);
-            (b - a).cross(c - a).length_squared() > 0.0
-        })
-        .copied()
-        .collect();
-    (points.to_vec(), kept)
+    (
+        points.to_vec(),
+        crate::mesh_file::with_area(points, triangles),
+    )
 }
 
 /// Shared mesh data a static geom keeps for its triangles, in the geom's frame.

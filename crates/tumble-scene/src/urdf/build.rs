@@ -571,13 +571,16 @@ fn hull(mesh: &MeshData, scale: Vec3, file: &std::path::Path, at: &str) -> Resul
     })
 }
 
+/// A static body's one mesh as the engine's mesh shape: its triangles of zero area (after
+/// scaling) dropped, as the MJCF reader does.
 fn static_mesh(mesh: &MeshData, scale: Vec3, pose: &Pose, at: &str) -> Result<Shape> {
-    let vertices = mesh
+    let vertices: Vec<Vec3> = mesh
         .vertices
         .iter()
         .map(|v| pose.position + pose.rotation * (*v * scale))
         .collect();
-    TriMesh::new(vertices, mesh.triangles.clone())
+    let triangles = crate::mesh_file::with_area(&vertices, &mesh.triangles);
+    TriMesh::new(vertices, triangles)
         .map(Shape::TriMesh)
         .map_err(|e| SceneError::from_engine(e, "").within_at(at, "geometry.mesh"))
 }

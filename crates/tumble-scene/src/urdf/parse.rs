@@ -139,6 +139,9 @@ pub(crate) struct Source<'a> {
 
 /// Parses URDF text.
 pub(crate) fn parse(text: &str, src: &Source<'_>) -> Result<Model> {
+    // NUL bytes after the last element (written by some exporters, e.g. PyBullet's
+    // humanoid.urdf) are not XML, and say nothing: dropped, as TinyXML (PyBullet) does.
+    let text = text.trim_end_matches(|c: char| c == '\0' || c.is_whitespace());
     let text = blank_declaration(text);
     let doc = Document::parse(&text).map_err(|e| {
         let pos = e.pos();
@@ -230,6 +233,18 @@ impl Cx<'_, '_> {
             .iter()
             .filter_map(|w| w.parse::<Real>().ok().filter(|x| x.is_finite()))
             .collect();
+        if nums.len() == words.len() && nums.len() > N {
+            // PyBullet reads the first N and ignores the rest (`scale="1 1 1 1"`).
+            self.warnings.borrow_mut().push(format!(
+                "{}: {field}: expected {N} numbers, got {} ('{}'); the first {N} used, as PyBullet does",
+                self.at(node),
+                nums.len(),
+                printable(text)
+            ));
+            let mut first = [0.0; N];
+            first.copy_from_slice(&nums[..N]);
+            return Ok(Some(first));
+        }
         match <[Real; N]>::try_from(nums) {
             Ok(a) if words.len() == N => Ok(Some(a)),
             _ => Err(self.err(

@@ -145,6 +145,13 @@ impl TriMesh {
         Ok(mesh)
     }
 
+    /// Whether [`TriMesh::new`] takes the triangle `a b c`: one of non-zero area by its
+    /// test (no two edges parallel to rounding), so that importers can drop the others
+    /// (sliver faces of exported meshes) before building.
+    pub fn has_area(a: Vec3, b: Vec3, c: Vec3) -> bool {
+        face_normal(a, b, c).is_some()
+    }
+
     /// Vertices, local frame.
     pub fn vertices(&self) -> &[Vec3] {
         &self.vertices
