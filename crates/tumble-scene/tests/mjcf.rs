@@ -435,6 +435,33 @@ fn several_joints_in_one_body_chain_and_keep_their_coordinates() {
     }
 }
 
+/// Gymnasium's pusher.xml: a goal marker of 4e-10 kg on two slide joints. Its light
+/// intermediate body, a thousandth of that, would be below the engine's least mass; it is
+/// kept at the least instead, and the model loads as MuJoCo loads it.
+#[test]
+fn a_light_intermediate_body_of_a_tiny_body_is_kept_at_the_engines_least_mass() {
+    let text = r#"<mujoco><worldbody>
+      <body name="goal" pos="0.45 -0.05 -0.3230">
+        <joint name="goal_slidex" type="slide" axis="1 0 0" limited="true" range="-10.3213 10.3"/>
+        <joint name="goal_slidey" type="slide" axis="0 1 0" limited="true" range="-10.3213 10.3"/>
+        <geom type="cylinder" size=".08 .001 .1" density="0.00001" contype="0" conaffinity="0"/>
+      </body></worldbody></mujoco>"#;
+    let mut world = z_up();
+    let m = mjcf::load(write("tiny.xml", text), &mut world, &MjcfOptions::default()).unwrap();
+    let goal = world.body(m.body("goal").unwrap()).unwrap();
+    let expect = PI * 0.08 * 0.08 * 0.002 * 1e-5;
+    assert!(close(goal.mass(), expect, 1e-6), "{}", goal.mass());
+    let least = world
+        .bodies()
+        .map(|(_, b)| b.mass())
+        .filter(|m| *m > 0.0)
+        .fold(Real::INFINITY, Real::min);
+    assert_eq!(least, tumble::limits::MIN_MASS);
+    for _ in 0..10 {
+        world.step(0.002).unwrap();
+    }
+}
+
 /// `<frame>` places what it holds: a box 1 m up a frame turned 90° about z, in a body.
 #[test]
 fn frames_place_their_geoms_and_bodies() {

@@ -103,16 +103,19 @@ fn ordered(a: BodyId, b: BodyId) -> (BodyId, BodyId) {
 }
 
 /// The body's mass properties: its parts', or for an intermediate body a thousandth of
-/// the body it carries.
+/// the body it carries, but never below the engine's least mass and moment (a marker
+/// body of 4e-10 kg, as Gymnasium's pusher goal, would otherwise give 4e-13 kg, which
+/// the engine refuses though the body it carries is taken).
 fn mass_of(plan: &Plan, b: &PlanBody) -> MassProperties {
+    use tumble::limits::{MIN_MASS, MIN_MOMENT};
     match b.light_of {
         Some(carried) => {
             let m = super::build::sum(plan.bodies[carried].mass.iter().copied());
             MassProperties {
-                mass: m.mass * LIGHT,
+                mass: (m.mass * LIGHT).max(MIN_MASS),
                 center: Vec3::ZERO,
                 inertia: tumble::Mat3::from_diagonal(Vec3::splat(
-                    crate::mjcf::build::largest_moment(&m) * LIGHT,
+                    (crate::mjcf::build::largest_moment(&m) * LIGHT).max(MIN_MOMENT),
                 )),
             }
         }
