@@ -4,7 +4,9 @@
 //! relative to `other`:
 //!
 //! ```text
-//! hinge     angle about the axis (rad) in (−π, π], zero at creation; rate axis·(ω_a − ω_b)
+//! hinge     angle about the axis (rad), zero at creation, read in the turn about the middle
+//!           of its limits (else its servo's target, its spring's rest, or 0: (−π, π]; see
+//!           `angle_window`); rate axis·(ω_a − ω_b)
 //! slider    axis·(p_a − p_b) (m): the anchors' offset along the axis (zero at creation
 //!           when the anchors coincide then, as the scene format and Python's defaults
 //!           make them); its rate
@@ -80,11 +82,52 @@ fn anchors(joint: &Joint, a: &BodyMotion, b: &BodyMotion) -> (Vec3, Vec3, Vec3) 
     (pa, pb, pb - pa)
 }
 
-/// The hinge angle of `body` about its axis relative to `other` (rad, in (−π, π]).
+/// The hinge angle of `body` about its axis relative to `other` (rad), in the joint's
+/// window (see [`angle_window`]).
 pub(crate) fn hinge_angle(joint: &Joint, qa: Quat, qb: Quat) -> Real {
     let axis = qa * joint.axis;
     let (ra, rb) = (qa * joint.reference, qb * joint.other_reference);
-    axis.dot(rb.cross(ra)).atan2(ra.dot(rb))
+    let angle = axis.dot(rb.cross(ra)).atan2(ra.dot(rb));
+    let o = joint.def.kind.options();
+    in_window(
+        angle,
+        angle_window(
+            o.limits,
+            o.servo.map(|s| s.target),
+            o.spring.map(|s| s.target),
+        ),
+    )
+}
+
+/// The middle of the turn in which a joint reads its angle: the poses tell an angle only
+/// up to whole turns, and read in (−π, π] a joint whose limits reach past π cannot tell
+/// one side of its range from the other (a URDF arm's joint of [−0.09, 3.82] rad read
+/// 3.2 rad as −3.08, below its lower limit, and the limit threw it round at 650 rad/s).
+/// So the angle is read in the turn centred on the middle of its limits when they span
+/// less than a turn, else on its servo's target (the servo then always takes the short
+/// way), else on its spring's rest angle, else on zero: (−π, π].
+pub(crate) fn angle_window(
+    limits: Option<[Real; 2]>,
+    servo: Option<Real>,
+    spring: Option<Real>,
+) -> Real {
+    let tau = 2.0 * crate::math::PI;
+    match limits {
+        Some([lo, hi]) if lo.is_finite() && hi.is_finite() && hi - lo < tau => 0.5 * (lo + hi),
+        _ => servo.or(spring).filter(|c| c.is_finite()).unwrap_or(0.0),
+    }
+}
+
+/// `angle` (in (−π, π]) moved by whole turns into the turn centred on `centre`; unchanged,
+/// bit for bit, when it is in it already.
+pub(crate) fn in_window(angle: Real, centre: Real) -> Real {
+    let tau = 2.0 * crate::math::PI;
+    let turns = ((centre - angle) / tau).round();
+    if turns == 0.0 {
+        angle
+    } else {
+        angle + tau * turns
+    }
 }
 
 /// The rotation of `body` relative to `other` since creation, in `other`'s frame.

@@ -102,6 +102,17 @@ impl FreeDrive {
         }
     }
 
+    /// An angle of the free coordinate (a hinge's or a twist's, in (−π, π]) read in the
+    /// turn its limits, servo or spring centre (see `coords::angle_window`).
+    pub fn in_window(&self, angle: Real) -> Real {
+        let centre = crate::dynamics::joint::coords::angle_window(
+            self.limits,
+            self.servo.map(|s| s.target),
+            self.spring.map(|s| s.target),
+        );
+        crate::dynamics::joint::coords::in_window(angle, centre)
+    }
+
     /// Whether nothing acts on the free coordinate.
     pub fn is_idle(&self) -> bool {
         self.limits.is_none()

@@ -78,7 +78,7 @@ impl JointConstraint {
                 let axis = self.axis(fr);
                 let (ra, rb) = (fr.sa.q * self.reference_a, fr.sb.q * self.reference_b);
                 let angle = axis.dot(rb.cross(ra)).atan2(ra.dot(rb));
-                Some((Row::angular(axis).negated(), angle))
+                Some((Row::angular(axis).negated(), self.drive.in_window(angle)))
             }
             FreeAxis::Twist => {
                 if self.drive.is_idle() {
@@ -90,7 +90,7 @@ impl JointConstraint {
                 let ra = flat(fr.sa.q * self.reference_a)?;
                 let rb = flat(fr.sb.q * self.reference_b)?;
                 let angle = mid.dot(rb.cross(ra)).atan2(ra.dot(rb));
-                Some((Row::angular(mid).negated(), angle))
+                Some((Row::angular(mid).negated(), self.drive.in_window(angle)))
             }
             FreeAxis::Translation => {
                 let axis = self.axis(fr);
