@@ -11,7 +11,7 @@ use crate::world::{Inner, PyWorld};
 
 /// A body in a world. Its properties read the live state (arrays are fresh copies); the
 /// assignable ones (position, orientation, velocity, angular_velocity, friction,
-/// restitution, collision_group, collision_mask, linear_damping, angular_damping,
+/// restitution, collision_group, collision_mask, collision_owner, linear_damping, angular_damping,
 /// gravity_scale, sensor, one_way) edit it, checked as `add_body` checks them, and wake it. Handles of
 /// a removed body raise ValueError. Two handles of the same body compare equal.
 #[pyclass(module = "tumble", name = "Body", frozen)]
@@ -237,6 +237,20 @@ impl PyBody {
             let (group, _) = g.world.body(id)?.collision_filter();
             g.world.set_collision_filter(id, group, mask)
         })
+    }
+
+    /// Collision owner (0: none): bodies with the same non-zero owner never collide with
+    /// each other whatever their groups and masks (an imported URDF model's links share
+    /// one unless `self_collision=True`); assignable.
+    #[getter]
+    fn collision_owner(&self) -> PyResult<u32> {
+        self.read(|b| b.collision_owner())
+    }
+
+    #[setter]
+    fn set_collision_owner(&self, value: i64) -> PyResult<()> {
+        let owner = layer_bits(value, "collision_owner")?;
+        self.edit(|g, id| g.world.set_collision_owner(id, owner))
     }
 
     /// Linear damping (1/s, >= 0): dv/dt = −c v besides the forces; assignable.

@@ -64,6 +64,7 @@ fn options(
     orientation: Option<&Bound<'_, PyAny>>,
     merge_fixed: bool,
     prefix: Option<String>,
+    self_collision: bool,
 ) -> PyResult<UrdfOptions> {
     Ok(UrdfOptions {
         fixed_base,
@@ -71,6 +72,7 @@ fn options(
         orientation: quat_or(orientation, "orientation")?,
         merge_fixed,
         prefix: prefix.unwrap_or_default(),
+        self_collision,
     })
 }
 
@@ -79,12 +81,14 @@ impl PyWorld {
     /// A world holding the URDF model at `path`, with `gravity` (m/s², default z-up
     /// (0, 0, −9.81): URDF models are z-up and are never turned). `fixed_base` makes the
     /// root link static; `position` (m) and `orientation` [x, y, z, w] place it;
-    /// `merge_fixed` makes links joined by fixed joints one body (else welds). Bodies and
-    /// joints are named as in the file (`world.body("upper")`, `world.joint("elbow")`).
-    /// A bad file raises ValueError naming file, line and element.
+    /// `merge_fixed` makes links joined by fixed joints one body (else welds);
+    /// `self_collision` makes the model's links that no joint connects collide with each
+    /// other (default False, as PyBullet's: they still collide with everything else).
+    /// Bodies and joints are named as in the file (`world.body("upper")`,
+    /// `world.joint("elbow")`). A bad file raises ValueError naming file, line and element.
     #[staticmethod]
     #[pyo3(signature = (path, *, fixed_base = true, gravity = None, position = None,
-        orientation = None, merge_fixed = true))]
+        orientation = None, merge_fixed = true, self_collision = false))]
     fn from_urdf(
         path: std::path::PathBuf,
         fixed_base: bool,
@@ -92,12 +96,20 @@ impl PyWorld {
         position: Option<&Bound<'_, PyAny>>,
         orientation: Option<&Bound<'_, PyAny>>,
         merge_fixed: bool,
+        self_collision: bool,
     ) -> PyResult<Self> {
         let def = WorldDef {
             gravity: vec3_or(gravity, "gravity", urdf::GRAVITY)?,
             ..WorldDef::default()
         };
-        let opts = options(fixed_base, position, orientation, merge_fixed, None)?;
+        let opts = options(
+            fixed_base,
+            position,
+            orientation,
+            merge_fixed,
+            None,
+            self_collision,
+        )?;
         let mut world = World::try_new(&def).map_err(engine)?;
         urdf::load(&path, &mut world, &opts).map_err(scene)?;
         Ok(PyWorld::new_inner(Inner {
@@ -112,10 +124,12 @@ impl PyWorld {
     /// Adds the URDF model at `path` to this world and returns a tumble.Model (its bodies
     /// and joints by the file's names). Keywords as `from_urdf`'s, and `prefix`, put
     /// before every body and joint name in the world (the Model's keys stay the file's)
-    /// so that one file can be added twice. All or nothing: a bad file raises ValueError
-    /// and adds nothing.
+    /// so that one file can be added twice (the copies collide with each other whatever
+    /// `self_collision` says). All or nothing: a bad file raises ValueError and adds
+    /// nothing.
     #[pyo3(signature = (path, *, position = None, orientation = None, fixed_base = true,
-        merge_fixed = true, prefix = None))]
+        merge_fixed = true, prefix = None, self_collision = false))]
+    #[allow(clippy::too_many_arguments)]
     fn add_urdf<'py>(
         slf: &Bound<'py, Self>,
         path: std::path::PathBuf,
@@ -124,8 +138,16 @@ impl PyWorld {
         fixed_base: bool,
         merge_fixed: bool,
         prefix: Option<String>,
+        self_collision: bool,
     ) -> PyResult<PyModel> {
-        let opts = options(fixed_base, position, orientation, merge_fixed, prefix)?;
+        let opts = options(
+            fixed_base,
+            position,
+            orientation,
+            merge_fixed,
+            prefix,
+            self_collision,
+        )?;
         let imported = {
             let mut g = slf.get().lock()?;
             urdf::load(&path, &mut g.world, &opts).map_err(scene)?

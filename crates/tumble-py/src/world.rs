@@ -432,7 +432,8 @@ impl PyWorld {
     /// to the xy plane; `friction`, `restitution`, `rolling_resistance` (dimensionless:
     /// rolling torque at most μ_r r N) and `torsional_friction` (m: spinning torque at most
     /// μ_t N; a pair uses the larger of each), `collision_group`/`collision_mask`
-    /// (32-bit layer sets), `bullet` (continuous collision against every body that is
+    /// (32-bit layer sets), `collision_owner` (bodies with the same non-zero owner never
+    /// collide with each other; 0: none), `bullet` (continuous collision against every body that is
     /// not a bullet), `linear_damping` and `angular_damping` (1/s: dv/dt = −c v,
     /// dL/dt = −c L besides the forces), `gravity_scale` (times the world's gravity),
     /// `sensor` (reports overlaps in `sensor_events()`, with no contact response) and
@@ -443,7 +444,7 @@ impl PyWorld {
         kind = "dynamic".to_string(), name = None, planar = false, inertia = None,
         center_of_mass = None, friction = 0.6, restitution = 0.0, rolling_resistance = 0.0,
         torsional_friction = 0.0, collision_group = 1, collision_mask = 0xFFFF_FFFF,
-        bullet = false, linear_damping = 0.0, angular_damping = 0.0, gravity_scale = 1.0,
+        collision_owner = 0, bullet = false, linear_damping = 0.0, angular_damping = 0.0, gravity_scale = 1.0,
         sensor = false, one_way = None))]
     #[allow(clippy::too_many_arguments)]
     fn add_body<'py>(
@@ -466,6 +467,7 @@ impl PyWorld {
         torsional_friction: f64,
         collision_group: i64,
         collision_mask: i64,
+        collision_owner: i64,
         bullet: bool,
         linear_damping: f64,
         angular_damping: f64,
@@ -507,6 +509,7 @@ impl PyWorld {
             planar,
             collision_group: layer_bits(collision_group, "collision_group")?,
             collision_mask: layer_bits(collision_mask, "collision_mask")?,
+            collision_owner: layer_bits(collision_owner, "collision_owner")?,
             friction: real(friction),
             restitution: real(restitution),
             rolling_resistance: real(rolling_resistance),

@@ -218,3 +218,51 @@ def test_pybullet_data_models_load_and_run_with_the_files_total_mass(bullet, nam
     assert ours == pytest.approx(theirs, rel=1e-6)
     w.step(0.005, steps=100)
     assert all(np.isfinite(b.position).all() for b in w.bodies)
+
+
+def folded(overlap):
+    """A base, a middle link hinged above it and a tip hinged below the middle: base and
+    tip overlap by `overlap` (m) and no joint connects them."""
+
+    def link(name, size):
+        return f"""<link name="{name}"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="{size} {size} {size}"/></geometry></collision></link>"""
+
+    lim = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+    return f"""<robot name="folded">{link("base", 0.2)}{link("mid", 0.1)}{link("tip", 0.1)}
+  <joint name="up" type="revolute"><parent link="base"/><child link="mid"/>
+    <origin xyz="0 0 0.5"/><axis xyz="0 1 0"/>{lim}</joint>
+  <joint name="down" type="revolute"><parent link="mid"/><child link="tip"/>
+    <origin xyz="0 0 {-0.35 - overlap}"/><axis xyz="0 1 0"/>{lim}</joint>
+</robot>"""
+
+
+def touching(w):
+    return sorted({tuple(sorted((c.body_a.name, c.body_b.name))) for c in w.update_contacts()})
+
+
+@pytest.mark.parametrize("overlap", [0.005, 0.03])
+def test_a_models_links_collide_with_each_other_only_with_self_collision(tmp_path, overlap):
+    path = tmp_path / "folded.urdf"
+    path.write_text(folded(overlap))
+    # PyBullet's default: a model's own links pass through each other.
+    assert touching(tumble.World.from_urdf(path)) == []
+    assert touching(tumble.World.from_urdf(path, self_collision=True)) == [("base", "tip")]
+    # A second copy collides with the first, which still does not collide with itself.
+    w = tumble.World.from_urdf(path)
+    w.add_urdf(path, prefix="b_", position=(0.05, 0, 0), self_collision=True)
+    assert touching(w) == sorted(
+        [("b_base", "tip"), ("b_mid", "mid"), ("b_tip", "base"), ("b_tip", "tip"), ("b_base", "b_tip")]
+    )
+    # The owner is a body property: giving the tip another owner brings its contact back;
+    # the links' groups and masks are untouched.
+    w = tumble.World.from_urdf(path)
+    tip = w.body("tip")
+    assert tip.collision_owner == w.body("base").collision_owner != 0
+    assert (tip.collision_group, tip.collision_mask) == (1, 0xFFFFFFFF)
+    tip.collision_owner = 0
+    assert touching(w) == [("base", "tip")]
+    with pytest.raises(ValueError, match=r"collision_owner: must be a whole number in \[0, 2\*\*32\)"):
+        tip.collision_owner = -1
+    assert tip.collision_owner == 0

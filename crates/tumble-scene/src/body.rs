@@ -5,7 +5,7 @@ use tumble::{BodyDef, BodyId, BodyKind, InertiaSpec, MassSpec, Mat3, Quat, Shape
 use crate::error::{printable, Result};
 use crate::reader::{Node, Obj};
 
-const BODY_KEYS: [&str; 25] = [
+const BODY_KEYS: [&str; 26] = [
     "name",
     "kind",
     "shape",
@@ -20,6 +20,7 @@ const BODY_KEYS: [&str; 25] = [
     "planar",
     "collision_group",
     "collision_mask",
+    "collision_owner",
     "friction",
     "restitution",
     "rolling_resistance",
@@ -73,6 +74,7 @@ pub(crate) fn body(node: &Node<'_>) -> Result<(BodyDef, Shape)> {
         planar: obj.bool("planar")?.unwrap_or(false),
         collision_group: bits(&obj, "collision_group")?.unwrap_or(1),
         collision_mask: bits(&obj, "collision_mask")?.unwrap_or(u32::MAX),
+        collision_owner: bits(&obj, "collision_owner")?.unwrap_or(0),
         friction: obj.real("friction")?.unwrap_or(BodyDef::default().friction),
         restitution: obj.real("restitution")?.unwrap_or(0.0),
         rolling_resistance: obj.real("rolling_resistance")?.unwrap_or(0.0),

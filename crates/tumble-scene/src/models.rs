@@ -1,9 +1,10 @@
 //! The `models` section: model files placed in the scene,
 //! `{"file": "arm.urdf", "position": [..], "orientation": [..], "fixed_base": true,
-//! "merge_fixed": true, "prefix": "left_"}`, or an MJCF file (`.xml`) with `position`,
-//! `orientation` and `prefix` (its bodies float or are welded as the file says, so
-//! `fixed_base` and `merge_fixed` do not apply; the scene's gravity and integrator stay,
-//! the file's `<option>` is not read). Files are found relative to the scene file's
+//! "merge_fixed": true, "prefix": "left_", "self_collision": false}`, or an MJCF file
+//! (`.xml`) with `position`, `orientation` and `prefix` (its bodies float or are welded
+//! as the file says and its geoms' `contype`/`conaffinity` say what collides, so
+//! `fixed_base`, `merge_fixed` and `self_collision` do not apply; the scene's gravity and
+//! integrator stay, the file's `<option>` is not read). Files are found relative to the scene file's
 //! folder; their links (bodies) become bodies named as in the file (after `prefix`),
 //! which the scene's `joints` and `forces` can refer to.
 
@@ -17,13 +18,14 @@ use crate::reader::{Node, Obj};
 use crate::urdf::{self, UrdfOptions};
 use crate::FileKind;
 
-const MODEL_KEYS: [&str; 6] = [
+const MODEL_KEYS: [&str; 7] = [
     "file",
     "position",
     "orientation",
     "fixed_base",
     "merge_fixed",
     "prefix",
+    "self_collision",
 ];
 
 /// Adds every model of `obj`'s `models`, appending the bodies' labels to `names` and
@@ -61,6 +63,7 @@ pub(crate) fn add_models(
             orientation: m.quat("orientation")?.unwrap_or(d.orientation),
             merge_fixed: m.bool("merge_fixed")?.unwrap_or(d.merge_fixed),
             prefix: m.str("prefix")?.unwrap_or("").to_string(),
+            self_collision: m.bool("self_collision")?.unwrap_or(d.self_collision),
         };
         let imported = urdf::load(&file, world, &opts)
             .map_err(|e| SceneError::new(format!("{}: {}", node.path(), e.field), e.reason))?;
@@ -87,6 +90,11 @@ fn add_mjcf(
         if let Some(n) = m.get(key) {
             return Err(n.err("not used for MJCF models (the file says which bodies move)"));
         }
+    }
+    if let Some(n) = m.get("self_collision") {
+        return Err(n.err(
+            "not used for MJCF models (the geoms' contype and conaffinity say what collides)",
+        ));
     }
     let d = MjcfOptions::default();
     let opts = MjcfOptions {

@@ -242,6 +242,9 @@ fn body(b: &Body, color: Option<[u8; 3]>) -> String {
     }
     f.add("collision_group", group.to_string());
     f.add("collision_mask", mask.to_string());
+    if b.collision_owner() != 0 {
+        f.add("collision_owner", b.collision_owner().to_string());
+    }
     let numbers = [
         ("friction", b.friction()),
         ("restitution", b.restitution()),

@@ -46,7 +46,7 @@ fn misspelt_keys_are_refused_with_the_allowed_ones() {
         error(&one_body(r#""velocty": [1, 0, 0]"#)),
         "bodies[0].velocty: unknown key (expected one of: name, kind, shape, mass, density, \
          inertia, center_of_mass, position, orientation, velocity, angular_velocity, planar, \
-         collision_group, collision_mask, friction, restitution, rolling_resistance, \
+         collision_group, collision_mask, collision_owner, friction, restitution, rolling_resistance, \
          torsional_friction, bullet, color, linear_damping, angular_damping, gravity_scale, \
          sensor, one_way)"
     );

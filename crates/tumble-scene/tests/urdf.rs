@@ -558,7 +558,13 @@ fn obj_and_binary_stl_meshes_become_hulls_and_static_meshes() {
         std::fs::write(pkg.join("meshes").join(file), &bytes).unwrap();
         let path = write(&pkg.join("urdf"), "meshy.urdf", &mesh_robot(file, "2 1 1"));
         let mut w = z_up();
-        let m = load(&path, &mut w, true);
+        // The block lands on its own model's ground: self-collision asked for (the
+        // model's links pass through each other by default, as in PyBullet).
+        let opts = UrdfOptions {
+            self_collision: true,
+            ..UrdfOptions::default()
+        };
+        let m = urdf::load(&path, &mut w, &opts).unwrap();
         let block = w.body(m.body("block").unwrap()).unwrap();
         let Shape::Compound(children) = block.shape() else {
             panic!("{file}: {:?}", block.shape().kind_name());
@@ -701,7 +707,7 @@ fn a_scene_places_models_whose_links_its_joints_can_name() {
     };
     assert_eq!(
         bad(r#"{"file": "double.urdf", "colour": "red"}"#),
-        "models[0].colour: unknown key (expected one of: file, position, orientation, fixed_base, merge_fixed, prefix)"
+        "models[0].colour: unknown key (expected one of: file, position, orientation, fixed_base, merge_fixed, prefix, self_collision)"
     );
     assert_eq!(
         bad(r#"{"file": "double.json"}"#),
@@ -999,4 +1005,114 @@ fn pybullets_leniencies_trailing_nul_extra_numbers_and_sliver_triangles_are_read
         panic!("not a mesh");
     };
     assert_eq!(mesh.len(), 12);
+}
+
+/// A base, a middle link hinged above it and a tip hinged below the middle, folded back
+/// onto the base: base and tip overlap by `overlap` (m) and no joint connects them.
+fn folded(overlap: Real) -> String {
+    let link = |name: &str, size: Real| {
+        format!(
+            r#"<link name="{name}"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="{size} {size} {size}"/></geometry></collision></link>"#
+        )
+    };
+    format!(
+        r#"<robot name="folded">
+  {base}{mid}{tip}
+  <joint name="up" type="revolute"><parent link="base"/><child link="mid"/>
+    <origin xyz="0 0 0.5"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <joint name="down" type="revolute"><parent link="mid"/><child link="tip"/>
+    <origin xyz="0 0 {back}"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>"#,
+        base = link("base", 0.2),
+        mid = link("mid", 0.1),
+        tip = link("tip", 0.1),
+        back = -0.5 + 0.15 - overlap,
+    )
+}
+
+/// The bodies touching each other after a contact update, as sorted name pairs.
+fn touching(w: &mut World) -> Vec<(String, String)> {
+    let ids: Vec<(BodyId, BodyId)> = w
+        .update_contacts()
+        .iter()
+        .map(|c| (c.body_a, c.body_b))
+        .collect();
+    let mut pairs: Vec<(String, String)> = ids
+        .into_iter()
+        .map(|(a, b)| {
+            let name = |id| w.body(id).unwrap().name().unwrap();
+            let (a, b) = (name(a), name(b));
+            (a.min(b).to_string(), a.max(b).to_string())
+        })
+        .collect();
+    pairs.sort();
+    pairs.dedup();
+    pairs
+}
+
+#[test]
+fn a_models_links_collide_with_each_other_only_when_asked_and_always_with_other_models() {
+    let d = dir("self-collision");
+    for (i, overlap) in [0.004, 0.02, 0.05].into_iter().enumerate() {
+        let file = write(&d, &format!("folded{i}.urdf"), &folded(overlap));
+        let add = |w: &mut World, self_collision: bool, prefix: &str, x: Real| {
+            let opts = UrdfOptions {
+                self_collision,
+                prefix: prefix.to_string(),
+                position: Vec3::new(x, 0.0, 0.0),
+                ..UrdfOptions::default()
+            };
+            urdf::load(&file, w, &opts).unwrap();
+        };
+        // PyBullet's default: the model's own links pass through each other.
+        let mut w = z_up();
+        add(&mut w, false, "", 0.0);
+        assert_eq!(touching(&mut w), Vec::<(String, String)>::new());
+        // Asked for, base and tip (not joined) touch; joined links still do not.
+        let mut w = z_up();
+        add(&mut w, true, "", 0.0);
+        assert_eq!(touching(&mut w), [("base".into(), "tip".into())]);
+        // A second copy overlapping the first collides with it though neither collides
+        // with itself; one with self-collision beside one without composes the same way.
+        for second in [false, true] {
+            let mut w = z_up();
+            add(&mut w, false, "", 0.0);
+            add(&mut w, second, "b_", 0.05);
+            let mut expected: Vec<(String, String)> = vec![
+                ("b_base".into(), "tip".into()),
+                ("b_mid".into(), "mid".into()),
+                ("b_tip".into(), "base".into()),
+                ("b_tip".into(), "tip".into()),
+            ];
+            if second {
+                expected.push(("b_base".into(), "b_tip".into()));
+            }
+            expected.sort();
+            assert_eq!(
+                touching(&mut w),
+                expected,
+                "overlap {overlap}, second {second}"
+            );
+            // A user's own groups stay as set, and the owners survive a save and load.
+            let tip = w.find_body("tip").unwrap();
+            w.set_collision_filter(tip, 2, u32::MAX).unwrap();
+            let saved = tumble_scene::save(&w);
+            let mut back = tumble_scene::load_str(&saved).unwrap().world;
+            assert_eq!(touching(&mut back), expected);
+            let tip = back.body(back.find_body("tip").unwrap()).unwrap();
+            assert_eq!(tip.collision_filter(), (2, u32::MAX));
+        }
+    }
+    // In a scene's models: the key, and MJCF refusing it.
+    write(&d, "folded.urdf", &folded(0.02));
+    let scene = |key: &str| {
+        let text = format!(r#"{{"models": [{{"file": "folded.urdf"{key}}}]}}"#);
+        let path = write(&d, "scene.json", &text);
+        tumble_scene::load(path.to_str().unwrap())
+    };
+    assert_eq!(touching(&mut scene("").unwrap().world).len(), 0);
+    let mut w = scene(r#", "self_collision": true"#).unwrap().world;
+    assert_eq!(touching(&mut w), [("base".into(), "tip".into())]);
 }

@@ -341,3 +341,49 @@ fn setters_wake_the_body() {
         );
     }
 }
+
+/// Three overlapping cubes in the air, the first two of one collision owner: only the
+/// pairs with the third touch. Setting a mask keeps the owner; setting the third's owner
+/// to theirs ends its contacts, to 0 brings them back. A snapshot keeps the owners.
+#[test]
+fn bodies_of_one_collision_owner_do_not_collide() {
+    let mut w = World::new(&WorldDef::default());
+    assert_eq!(w.unused_collision_owner(), 1);
+    let owner = w.unused_collision_owner();
+    let cube = |w: &mut World, x: Real, owner: u32| {
+        let def = BodyDef {
+            position: Vec3::new(x, 5.0, 0.0),
+            collision_owner: owner,
+            ..Default::default()
+        };
+        w.create_body(&def, Shape::cuboid(Vec3::splat(0.5)))
+            .unwrap()
+    };
+    let a = cube(&mut w, 0.0, owner);
+    let b = cube(&mut w, 0.3, owner);
+    let c = cube(&mut w, 0.6, 0);
+    assert_eq!(w.unused_collision_owner(), owner + 1);
+    let pairs = |w: &mut World| {
+        let mut p: Vec<(BodyId, BodyId)> = w
+            .update_contacts()
+            .iter()
+            .map(|k| (k.body_a.min(k.body_b), k.body_a.max(k.body_b)))
+            .collect();
+        p.sort_unstable();
+        p
+    };
+    assert_eq!(pairs(&mut w), vec![(a, c), (b, c)]);
+    w.set_collision_filter(a, 1, u32::MAX).unwrap();
+    assert_eq!(w.body(a).unwrap().collision_owner(), owner);
+    assert_eq!(pairs(&mut w), vec![(a, c), (b, c)]);
+    w.set_collision_owner(c, owner).unwrap();
+    assert_eq!(pairs(&mut w), vec![]);
+    let restored = World::from_snapshot(&w.snapshot()).unwrap();
+    let owners: Vec<u32> = [a, b, c]
+        .iter()
+        .map(|&id| restored.body(id).unwrap().collision_owner())
+        .collect();
+    assert_eq!(owners, vec![owner; 3]);
+    w.set_collision_owner(c, 0).unwrap();
+    assert_eq!(pairs(&mut w), vec![(a, c), (b, c)]);
+}

@@ -88,9 +88,10 @@ enum Op {
 
 fn filter() -> impl Strategy<Value = Filter> {
     let mask = prop_oneof![Just(u32::MAX), 0u32..8];
-    (0u32..3, mask).prop_map(|(g, mask)| Filter {
+    (0u32..3, mask, 0u32..3).prop_map(|(g, mask, owner)| Filter {
         group: 1 << g,
         mask,
+        owner,
     })
 }
 
@@ -310,6 +311,7 @@ fn filters_need_both_directions_and_changes_take_effect() {
         Filter {
             group: 0b01,
             mask: 0b10,
+            owner: 0,
         },
     );
     let c = bp.insert(
@@ -319,6 +321,7 @@ fn filters_need_both_directions_and_changes_take_effect() {
         Filter {
             group: 0b10,
             mask: 0b01,
+            owner: 0,
         },
     );
     bp.insert(
@@ -328,6 +331,7 @@ fn filters_need_both_directions_and_changes_take_effect() {
         Filter {
             group: 0b10,
             mask: 0b00,
+            owner: 0,
         },
     );
     // a–c: each is in the other's mask. a–2: 2's mask excludes a. c–2: c's mask excludes 2.
@@ -337,6 +341,7 @@ fn filters_need_both_directions_and_changes_take_effect() {
         Filter {
             group: 0b10,
             mask: 0b00,
+            owner: 0,
         },
     );
     assert_eq!(pairs(&mut bp), vec![]);
@@ -345,6 +350,7 @@ fn filters_need_both_directions_and_changes_take_effect() {
         Filter {
             group: 0b01,
             mask: u32::MAX,
+            owner: 0,
         },
     );
     bp.set_filter(c, Filter::default());
@@ -354,6 +360,7 @@ fn filters_need_both_directions_and_changes_take_effect() {
         Filter {
             group: 0b11,
             mask: u32::MAX,
+            owner: 0,
         },
     );
     bp.set_filter(
@@ -361,6 +368,7 @@ fn filters_need_both_directions_and_changes_take_effect() {
         Filter {
             group: 0b10,
             mask: 0b01,
+            owner: 0,
         },
     );
     // Now 2 takes group 0b01 (both a and c are in it) and both take its group 0b10.

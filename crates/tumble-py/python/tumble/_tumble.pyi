@@ -215,6 +215,12 @@ class Body:
     @collision_mask.setter
     def collision_mask(self, value: int) -> None: ...
     @property
+    def collision_owner(self) -> int:
+        """Bodies with the same non-zero owner never collide with each other (0: none);
+        an imported URDF model's links share one unless self_collision=True; assignable."""
+    @collision_owner.setter
+    def collision_owner(self, value: int) -> None: ...
+    @property
     def linear_damping(self) -> float:
         """Linear damping (1/s): dv/dt = −c v besides the forces; assignable."""
     @linear_damping.setter
@@ -520,9 +526,11 @@ class World:
         position: Optional[Vec3Like] = None,
         orientation: Optional[QuatLike] = None,
         merge_fixed: bool = True,
+        self_collision: bool = False,
     ) -> World:
         """A world holding a URDF model; gravity defaults to z-up (0, 0, -9.81).
-        Bodies and joints are named as in the file. ValueError names file:line and element."""
+        Bodies and joints are named as in the file. The model's links collide with each
+        other only with self_collision=True. ValueError names file:line and element."""
     def add_urdf(
         self,
         path: Union[str, PathLike[str]],
@@ -532,8 +540,11 @@ class World:
         fixed_base: bool = True,
         merge_fixed: bool = True,
         prefix: Optional[str] = None,
+        self_collision: bool = False,
     ) -> Model:
-        """Adds a URDF model (all or nothing) and returns its bodies and joints by name."""
+        """Adds a URDF model (all or nothing) and returns its bodies and joints by name.
+        Its links collide with each other only with self_collision=True; with other
+        models (another copy too) and bodies always."""
     def add_body(
         self,
         shape: Shape,
@@ -555,6 +566,7 @@ class World:
         torsional_friction: float = 0.0,
         collision_group: int = 1,
         collision_mask: int = 0xFFFFFFFF,
+        collision_owner: int = 0,
         bullet: bool = False,
         linear_damping: float = 0.0,
         angular_damping: float = 0.0,

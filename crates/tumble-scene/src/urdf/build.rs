@@ -587,10 +587,14 @@ fn static_mesh(mesh: &MeshData, scale: Vec3, pose: &Pose, at: &str) -> Result<Sh
 
 /// Creates the planned bodies, then joints; on the first refusal removes what it made
 /// and returns the refusal, naming the element it came from.
-pub(crate) fn create(world: &mut World, plan: &Plan) -> Result<(Vec<BodyId>, Vec<JointId>)> {
+pub(crate) fn create(
+    world: &mut World,
+    plan: &Plan,
+    owner: u32,
+) -> Result<(Vec<BodyId>, Vec<JointId>)> {
     let mut bodies = Vec::with_capacity(plan.bodies.len());
     let mut joints = Vec::with_capacity(plan.joints.len());
-    let result = create_all(world, plan, &mut bodies, &mut joints);
+    let result = create_all(world, plan, owner, &mut bodies, &mut joints);
     if let Err(e) = result {
         for id in joints.into_iter().rev() {
             let _ = world.remove_joint(id);
@@ -606,12 +610,17 @@ pub(crate) fn create(world: &mut World, plan: &Plan) -> Result<(Vec<BodyId>, Vec
 fn create_all(
     world: &mut World,
     plan: &Plan,
+    owner: u32,
     bodies: &mut Vec<BodyId>,
     joints: &mut Vec<JointId>,
 ) -> Result<()> {
     for b in &plan.bodies {
+        let def = BodyDef {
+            collision_owner: owner,
+            ..b.def.clone()
+        };
         let id = world
-            .create_body(&b.def, b.shape.clone())
+            .create_body(&def, b.shape.clone())
             .map_err(|e| SceneError::from_engine(e, "").within_at(&b.at, ""))?;
         bodies.push(id);
     }

@@ -44,6 +44,12 @@ pub struct UrdfOptions {
     /// Put before every body and joint name in the world (the model's own names stay the
     /// keys of [`Imported`]), so that one file can be added more than once.
     pub prefix: String,
+    /// Whether the model's links collide with each other. Default `false`, as PyBullet's
+    /// (its `URDF_USE_SELF_COLLISION` flag turns it on): the bodies get one collision
+    /// owner of their own (`World::unused_collision_owner`), so they still collide with
+    /// everything else, another copy of the same model included. With `true`, links
+    /// that no joint connects collide.
+    pub self_collision: bool,
 }
 
 impl Default for UrdfOptions {
@@ -54,6 +60,7 @@ impl Default for UrdfOptions {
             orientation: Quat::IDENTITY,
             merge_fixed: true,
             prefix: String::new(),
+            self_collision: false,
         }
     }
 }
@@ -111,7 +118,12 @@ pub fn load_str(
     };
     let model = parse::parse(text, &src)?;
     let plan = build::plan(&model, opts)?;
-    let (created, joints) = build::create(world, &plan)?;
+    let owner = if opts.self_collision {
+        0
+    } else {
+        world.unused_collision_owner()
+    };
+    let (created, joints) = build::create(world, &plan, owner)?;
     Ok(Imported {
         name: model.name,
         bodies: plan

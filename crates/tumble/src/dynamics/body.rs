@@ -88,6 +88,11 @@ pub struct BodyDef {
     /// Layers it collides with (bits); two bodies collide when each one's group meets the
     /// other's mask. Default: all.
     pub collision_mask: u32,
+    /// Bodies with the same non-zero owner never collide with each other, whatever their
+    /// groups and masks (the links of one model: `World::unused_collision_owner` gives a
+    /// number no body has); with every other body, group and mask decide. Default 0: no
+    /// owner.
+    pub collision_owner: u32,
     /// Coulomb friction coefficient (dimensionless); a pair uses √(μ_a μ_b). Default 0.6.
     pub friction: Real,
     /// Coefficient of restitution in [0, 1]; a pair uses the larger. Default 0.
@@ -143,6 +148,7 @@ impl Default for BodyDef {
             planar: false,
             collision_group: 1,
             collision_mask: u32::MAX,
+            collision_owner: 0,
             friction: 0.6,
             restitution: 0.0,
             rolling_resistance: 0.0,
@@ -242,6 +248,7 @@ impl Body {
             filter: crate::collision::broad_phase::Filter {
                 group: def.collision_group,
                 mask: def.collision_mask,
+                owner: def.collision_owner,
             },
             friction: def.friction,
             restitution: def.restitution,
@@ -357,6 +364,10 @@ impl Body {
     /// Collision layers (group) and the layers it collides with (mask).
     pub fn collision_filter(&self) -> (u32, u32) {
         (self.filter.group, self.filter.mask)
+    }
+    /// The body's collision owner (see `BodyDef::collision_owner`; 0: none).
+    pub fn collision_owner(&self) -> u32 {
+        self.filter.owner
     }
     /// The filter of the body's broad-phase proxy: its own, or for a sensor one that
     /// pairs with nothing (sensors find their overlaps themselves).

@@ -92,13 +92,15 @@ pub enum ProxyKind {
 }
 
 /// Collision filter: two proxies may pair when `a.group & b.mask != 0` and
-/// `b.group & a.mask != 0`.
+/// `b.group & a.mask != 0`, and they do not have the same non-zero `owner`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Filter {
     /// Layers this proxy is in (bits).
     pub group: u32,
     /// Layers it collides with (bits).
     pub mask: u32,
+    /// Proxies with the same non-zero owner never pair (the links of one model); 0: none.
+    pub owner: u32,
 }
 
 impl Default for Filter {
@@ -106,6 +108,7 @@ impl Default for Filter {
         Filter {
             group: 1,
             mask: u32::MAX,
+            owner: 0,
         }
     }
 }
@@ -113,11 +116,17 @@ impl Default for Filter {
 impl Filter {
     /// The filter of a proxy that pairs with nothing (a sensor's: sensors find their
     /// overlaps by queries of their own).
-    pub const NONE: Filter = Filter { group: 0, mask: 0 };
+    pub const NONE: Filter = Filter {
+        group: 0,
+        mask: 0,
+        owner: 0,
+    };
 
     /// Whether the two filters let their proxies pair.
     pub fn allows(&self, other: &Filter) -> bool {
-        self.group & other.mask != 0 && other.group & self.mask != 0
+        self.group & other.mask != 0
+            && other.group & self.mask != 0
+            && (self.owner == 0 || self.owner != other.owner)
     }
 }
 
@@ -718,7 +727,7 @@ impl crate::codec::Code for ProxyId {
     }
 }
 crate::codec::codec_unit_enum!(ProxyKind { Static, Moving });
-crate::codec::codec_struct!(Filter { group, mask });
+crate::codec::codec_struct!(Filter { group, mask, owner });
 crate::codec::codec_struct!(Proxy {
     user,
     kind,

@@ -46,11 +46,41 @@ impl World {
     /// Sets a body's collision layers (`group`) and the layers it collides with (`mask`).
     /// The broad phase searches the body's pairs again at the next step: a pair the new
     /// filter forbids stops colliding there, one it allows starts.
+    /// The body's collision owner is kept.
     pub fn set_collision_filter(&mut self, id: BodyId, group: u32, mask: u32) -> Result<()> {
-        let filter = Filter { group, mask };
-        self.edit_property(id, |b| b.filter = filter)?;
+        self.edit_property(id, |b| {
+            b.filter = Filter {
+                group,
+                mask,
+                owner: b.filter.owner,
+            }
+        })?;
         self.refilter(id);
         Ok(())
+    }
+
+    /// Sets a body's collision owner (see `BodyDef::collision_owner`; 0: none): bodies
+    /// with the same non-zero owner stop colliding with each other at the next step.
+    pub fn set_collision_owner(&mut self, id: BodyId, owner: u32) -> Result<()> {
+        self.edit_property(id, |b| b.filter.owner = owner)?;
+        self.refilter(id);
+        Ok(())
+    }
+
+    /// A collision owner no body of the world has (never 0): the largest one in use plus
+    /// one, or if that is past `u32::MAX` the least free one. For a model's bodies, so
+    /// that they do not collide with each other but do with every other model's.
+    pub fn unused_collision_owner(&self) -> u32 {
+        let owners = self.bodies.list.iter().map(|b| b.filter.owner);
+        match owners.clone().max().unwrap_or(0).checked_add(1) {
+            Some(n) => n,
+            None => {
+                let used: std::collections::BTreeSet<u32> = owners.collect();
+                (1..=u32::MAX)
+                    .find(|n| !used.contains(n))
+                    .expect("fewer bodies than owners")
+            }
+        }
     }
 
     /// Hands body `id`'s proxy filter to the broad phase, which searches its pairs again
