@@ -198,6 +198,18 @@ pub(crate) struct Frame {
 }
 
 impl JointConstraint {
+    /// Whether the joint locks the bodies' relative rotation in some direction (hinge,
+    /// slider, fixed): such joints keep their spring in islands with a hub (see `passes`).
+    pub(super) fn locks_rotation(&self) -> bool {
+        self.spec.angular != AngularLock::Free
+    }
+
+    /// Whether either of its bodies is flagged in `flags` (per body; empty: none is).
+    pub(super) fn on(&self, flags: &[bool]) -> bool {
+        let flagged = |k: Option<usize>| k.is_some_and(|k| flags.get(k).copied().unwrap_or(false));
+        flagged(self.a) || flagged(self.b)
+    }
+
     /// The constraint for `joint`, with dense body indices (`None`: the world) and local
     /// centres of mass.
     pub fn new(index: usize, joint: &Joint, bodies: [(Option<usize>, Vec3); 2]) -> Self {

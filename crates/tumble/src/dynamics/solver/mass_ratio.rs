@@ -1,4 +1,4 @@
-//! Islands with a large mass ratio get stiffer contacts and four to six times the passes.
+//! Islands with a large mass ratio get stiffer contacts and four to sixteen times the passes.
 //!
 //! Gauss–Seidel hands a heavy body's weight down through a light one only in proportion to
 //! their mass ratio per pass, so at the default of one pass per substep a 1000 kg box on a
@@ -11,9 +11,22 @@
 //! takes twice the passes again to stay still: at 1:1000 the pair now rests 3.5 cm deep and moves at
 //! 3 mm/s, the slab sinks 6.9 mm, a 1:100 pair 3.5 mm (14 mm before) and is still. Their
 //! joints' spring is four times as stiff too (`Softness::stiffened`): a chain of 1 kg
-//! links holding 100 kg stretched 2.3 cm per joint at the defaults, now 7.4 mm.
+//! links holding 100 kg stretched 2.3 cm per joint at the defaults, now 7.4 mm. Joints
+//! that lock rotation in an island with a hub (below) are the exception (see
+//! `Solver::passes`): stiffened, they rang even with the extra passes.
 //! Stiffening and passes only the islands that need them keeps every other scene's cost
 //! and results as they were.
+//!
+//! A ratio need not sit across one pair. A body joined to several others carries their
+//! sum: PyBullet's minitaur hangs eight motors of 3 kg·m² each on a 3 kg·m² chassis by
+//! hinges, every pair 1:1, and at one pass the chassis's share of each hinge's angular
+//! rows was handed back and forth until it rang up from rounding to 400 rad/s within
+//! 0.6 s (59 J to 0.8 MJ in a second of falling onto the ground at dt = 0.01). Eight such
+//! children of equal mass and inertia is the least that did (seven grew by 1.7× in 0.6 s,
+//! six held); four passes held it up to 100 times the chassis's inertia. So a body whose
+//! joined partners' masses, or for joints that lock rotation their moments of inertia,
+//! sum to [`HUB_RATIO`] times its own, shared among several, makes its island heavy as well, with passes that
+//! grow with the load ([`hub_passes`]).
 
 use super::body::BodySim;
 use crate::dynamics::island::{find, union};
@@ -29,14 +42,96 @@ pub(crate) const HEAVY_RATIO: Real = 20.0;
 /// stiffened, at 4.4 mm/s with nine and 3.1 mm/s with six (and 0.19 m/s with three).
 pub(crate) const VERY_HEAVY_RATIO: Real = 200.0;
 
+/// Sum over a body's joined partners of their mass over its own (or, across joints that
+/// lock rotation, of their mean moment of inertia over its own) from which its island is
+/// heavy (see the module comment): the joint grid's bodies, with four equal partners,
+/// stay at 4.
+pub(crate) const HUB_RATIO: Real = 6.0;
+
+/// The most passes a hub's island gets, as a multiple of the world's.
+pub(crate) const HUB_PASSES: u32 = 16;
+
+/// The passes a hub's island gets for the largest load (see [`HUB_RATIO`]): √load + 1,
+/// from four (at a load of 6 to 9) to [`HUB_PASSES`]. Measured in zero gravity from a
+/// small spin (tests/joints.rs): eight partners of the chassis's inertia held with 4;
+/// twelve of ten times it (a load of 120) still gained 1 % at 8 passes and held at 12,
+/// as did six of a hundred times; sixteen of ten times (160) rang at 12 and held at 14.
+/// Twenty-four of a hundred times (800) rang even at 16: more passes are not a cure
+/// without end, and such a hub needs the joints solved together (not built).
+fn hub_passes(load: Real) -> u32 {
+    ((load.sqrt().ceil() as u32) + 1).clamp(4, HUB_PASSES)
+}
+
+/// A joint between two bodies of the step, as the hub search sees it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Joined {
+    pub a: usize,
+    pub b: usize,
+    /// Whether the joint locks their relative rotation in some direction.
+    pub locks_rotation: bool,
+}
+
+/// Mean principal moment of inertia (kg·m²): a third of the world tensor's trace, which
+/// turning does not change.
+fn mean_moment(s: &BodySim) -> Real {
+    (s.inertia.x_axis.x + s.inertia.y_axis.y + s.inertia.z_axis.z) / 3.0
+}
+
+/// The bodies that carry [`HUB_RATIO`] times their own mass or moment in joined
+/// partners, shared among several (at most half of it from one: a light body under one
+/// heavy partner is a pair's ratio, cured as such), and the largest such load; `None`
+/// when no body does, found in one scan of the joints.
+fn hubs(sims: &[BodySim], joined: &[Joined]) -> Option<(Vec<bool>, Real)> {
+    let moving = |k: usize| sims[k].moves;
+    // Per body: [sum, largest] of the partners' mass ratios, then of their moment ratios.
+    let mut load = vec![[0.0 as Real; 4]; sims.len()];
+    let mut add = |k: usize, at: usize, r: Real| {
+        load[k][at] += r;
+        load[k][at + 1] = load[k][at + 1].max(r);
+    };
+    for j in joined.iter().filter(|j| moving(j.a) && moving(j.b)) {
+        for (k, other) in [(j.a, j.b), (j.b, j.a)] {
+            add(k, 0, sims[k].inv_mass / sims[other].inv_mass);
+            let own = mean_moment(&sims[k]);
+            if j.locks_rotation && own > 0.0 {
+                add(k, 2, mean_moment(&sims[other]) / own);
+            }
+        }
+    }
+    let shared = |sum: Real, one: Real| sum >= HUB_RATIO && sum >= 2.0 * one;
+    let hub_load = |l: &[Real; 4]| {
+        let lin = if shared(l[0], l[1]) { l[0] } else { 0.0 };
+        let ang = if shared(l[2], l[3]) { l[2] } else { 0.0 };
+        lin.max(ang)
+    };
+    let largest = load.iter().map(hub_load).fold(0.0, Real::max);
+    let hub: Vec<bool> = load.iter().map(|l| hub_load(l) > 0.0).collect();
+    (largest > 0.0).then_some((hub, largest))
+}
+
+/// Which islands are heavy and how they are solved.
+#[derive(Debug, Default)]
+pub(crate) struct Heavy {
+    /// Per body, whether its island is heavy.
+    pub flags: Vec<bool>,
+    /// The multiple of the passes those islands get (one for all, from the largest ratio
+    /// or load).
+    pub passes: u32,
+    /// Per body, whether its island holds a hub (empty when none does): there joints
+    /// that lock rotation keep their spring (see the module comment).
+    pub hub: Vec<bool>,
+}
+
 /// For each body, whether it belongs to an island (bodies the solver moves, linked by the
 /// given contacts and joints) that holds a pair with a mass ratio of at least
-/// [`HEAVY_RATIO`], and the multiple of the passes those islands get (one for all, from
-/// the largest ratio); `None` when no island has one, the common case, found in one scan.
+/// [`HEAVY_RATIO`] or a hub (see [`HUB_RATIO`]), the multiple of the passes those islands
+/// get, and which hold a hub; `None` when no island is heavy, the common case, found in
+/// one scan.
 pub(crate) fn heavy_islands(
     sims: &[BodySim],
     links: impl Iterator<Item = (usize, usize)> + Clone,
-) -> Option<(Vec<bool>, u32)> {
+    joined: &[Joined],
+) -> Option<Heavy> {
     let moving = |k: usize| sims[k].moves;
     let ratio = |(a, b): (usize, usize)| {
         let (ma, mb) = (sims[a].inv_mass, sims[b].inv_mass);
@@ -48,10 +143,12 @@ pub(crate) fn heavy_islands(
     };
     let heavy_pair = |l: (usize, usize)| ratio(l) >= HEAVY_RATIO;
     let largest = links.clone().map(ratio).fold(1.0, Real::max);
-    if largest < HEAVY_RATIO {
+    let (hub, hub_load) = hubs(sims, joined).unzip();
+    if largest < HEAVY_RATIO && hub.is_none() {
         return None;
     }
     let passes = if largest >= VERY_HEAVY_RATIO { 6 } else { 4 };
+    let passes = passes.max(hub_load.map_or(0, hub_passes));
     let mut parent: Vec<usize> = (0..sims.len()).collect();
     for (a, b) in links.clone() {
         if moving(a) && moving(b) {
@@ -63,8 +160,24 @@ pub(crate) fn heavy_islands(
         let root = find(&mut parent, a);
         heavy_root[root] = true;
     }
-    let flags = (0..sims.len())
-        .map(|k| heavy_root[find(&mut parent, k)])
-        .collect();
-    Some((flags, passes))
+    let mut hub_root = vec![false; sims.len()];
+    let hubs = hub
+        .iter()
+        .flat_map(|h| h.iter().enumerate().filter(|&(_, &h)| h));
+    for (k, _) in hubs {
+        let root = find(&mut parent, k);
+        (heavy_root[root], hub_root[root]) = (true, true);
+    }
+    let mut of_root = |roots: &[bool]| -> Vec<bool> {
+        (0..sims.len())
+            .map(|k| roots[find(&mut parent, k)])
+            .collect()
+    };
+    let flags = of_root(&heavy_root);
+    let hub = if hub.is_some() {
+        of_root(&hub_root)
+    } else {
+        Vec::new()
+    };
+    Some(Heavy { flags, passes, hub })
 }

@@ -49,7 +49,7 @@ use crate::dynamics::body::Motion;
 use crate::dynamics::body::{Body, BodyKind};
 use crate::dynamics::force::Wrench;
 use crate::dynamics::integrate::{exact_spin, rotor_drift, System};
-use crate::dynamics::joint::Joint;
+use crate::dynamics::joint::{AngularLock, Joint};
 use crate::math::{Mat3, Real, Vec3};
 use crate::team::Parts;
 use crate::threads::Par;
@@ -98,6 +98,9 @@ pub(crate) struct Solver {
     heavy_contacts: usize,
     heavy_joints: usize,
     heavy_passes: u32,
+    /// Per body, whether its heavy island holds a hub (see `mass_ratio`); empty when none
+    /// does. There joints that lock rotation keep their spring (see `passes`).
+    hub: Vec<bool>,
     /// Per body, whether its island is a tall stack (see `stacks`); empty when none is.
     /// Such islands' contacts sit last, from `tall_contacts`, and run `fine` substeps
     /// for each of the world's (`fine` is 1 when there is none).
@@ -282,7 +285,7 @@ impl Solver {
     }
 
     /// `iterations` passes over the joints then the contacts, with `bias` or without
-    /// (relax); islands with a large mass ratio get two or three times as many. The substep's impulses
+    /// (relax); islands with a large mass ratio get 4 to 16 times as many. The substep's impulses
     /// are final once the last pass has visited a manifold, so with `totals` that pass adds
     /// them to the step's totals on its way instead of a separate walk over every point.
     fn passes(
@@ -302,25 +305,33 @@ impl Solver {
             soft: joint_pass.soft.stiffened(softness::STIFFEST),
             ..*joint_pass
         };
+        // Joints that lock rotation keep their spring in an island with a hub: stiffened,
+        // a chassis carrying eight hinged motors (see `mass_ratio`) rang up from rounding
+        // within a second even with four times the passes, and held unstiffened.
         let parts = [
             (
                 0..self.heavy_contacts,
                 0..self.heavy_joints,
                 iterations,
-                (rule, joint_pass),
+                (rule, joint_pass, joint_pass),
             ),
             (
                 self.heavy_contacts..self.tall_contacts,
                 self.heavy_joints..self.joints.len(),
                 self.heavy_passes * iterations,
-                (&stiffened, &stiff_joints),
+                (&stiffened, &stiff_joints, joint_pass),
             ),
         ];
-        for (contacts, joints, count, (rule, joint_pass)) in parts {
+        for (contacts, joints, count, (rule, joint_pass, locked_pass)) in parts {
             for k in 0..count {
                 let frames = &self.joint_frames[joints.clone()];
                 for (j, fr) in self.joints[joints.clone()].iter_mut().zip(frames) {
-                    j.solve(fr, &mut bodies.states, joint_pass, &mut self.joint_blocks);
+                    let pass = if j.locks_rotation() && j.on(&self.hub) {
+                        locked_pass
+                    } else {
+                        joint_pass
+                    };
+                    j.solve(fr, &mut bodies.states, pass, &mut self.joint_blocks);
                 }
                 let last = totals && k + 1 == count;
                 self.solve_pass(bodies, contacts.clone(), rule, bias, last);
@@ -466,16 +477,21 @@ impl Solver {
             .enumerate()
             .filter(|&(i, c)| !idle(c, i, ghosts))
             .map(|(_, c)| (c.index_a as usize, c.index_b as usize));
-        let joined =
-            joints
-                .iter()
-                .zip(joint_bodies)
-                .filter_map(|(j, link)| match (j.acts(), *link) {
-                    (true, [Some(a), Some(b)]) => Some((a, b)),
-                    _ => None,
-                });
-        (self.heavy, self.heavy_passes) =
-            mass_ratio::heavy_islands(&bodies.sims, touching.chain(joined)).unwrap_or_default();
+        let joined: Vec<mass_ratio::Joined> = joints
+            .iter()
+            .zip(joint_bodies)
+            .filter_map(|(j, link)| match (j.acts(), *link) {
+                (true, [Some(a), Some(b)]) => Some(mass_ratio::Joined {
+                    a,
+                    b,
+                    locks_rotation: j.def.kind.spec().angular != AngularLock::Free,
+                }),
+                _ => None,
+            })
+            .collect();
+        let links = touching.chain(joined.iter().map(|j| (j.a, j.b)));
+        let heavy = mass_ratio::heavy_islands(&bodies.sims, links, &joined).unwrap_or_default();
+        (self.heavy, self.heavy_passes, self.hub) = (heavy.flags, heavy.passes, heavy.hub);
     }
 
     /// The step's contact constraints, in colour order, and their lane groups; `slop` (m)
