@@ -378,6 +378,10 @@ fn joint_kind(joint: &super::parse::Joint) -> JointKind {
             servo,
         },
         JointType::Fixed => JointKind::Fixed,
+        JointType::Spherical => JointKind::Ball {
+            cone: None,
+            twist: None,
+        },
         _ => JointKind::Hinge {
             limits,
             motor,

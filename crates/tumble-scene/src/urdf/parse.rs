@@ -103,6 +103,8 @@ pub(crate) enum JointType {
     Fixed,
     Floating,
     Planar,
+    /// PyBullet's extension: a ball joint, three turning coordinates about one point.
+    Spherical,
 }
 
 /// One `<joint>`: the child's frame is `origin` in the parent's frame at zero.
@@ -438,12 +440,13 @@ impl Cx<'_, '_> {
             "fixed" => JointType::Fixed,
             "floating" => JointType::Floating,
             "planar" => JointType::Planar,
+            "spherical" => JointType::Spherical,
             other => {
                 return Err(self.err(
                     node,
                     "type",
                     format!(
-                        "unknown joint type '{}' (expected revolute, continuous, prismatic, fixed, floating or planar)",
+                        "unknown joint type '{}' (expected revolute, continuous, prismatic, fixed, floating, planar or spherical)",
                         printable(other)
                     ),
                 ))
@@ -461,11 +464,17 @@ impl Cx<'_, '_> {
             None => None,
         }
         .unwrap_or(Vec3::X);
-        let has_axis = !matches!(kind, JointType::Fixed | JointType::Floating);
+        let has_axis = !matches!(
+            kind,
+            JointType::Fixed | JointType::Floating | JointType::Spherical
+        );
         if has_axis && axis.length() < 1e-9 {
             return Err(self.err(node, "axis.xyz", "must be a non-zero direction"));
         }
         let (damping, friction) = self.dynamics(node)?;
+        if kind == JointType::Spherical {
+            self.spherical_unread(node, damping, friction);
+        }
         Ok(Joint {
             at: self.at(node),
             limits: self.limits(node, kind)?,
@@ -499,6 +508,29 @@ impl Cx<'_, '_> {
             return Ok(None);
         }
         Ok(Some([lower, upper]))
+    }
+
+    /// What of a `spherical` joint is read but not built: its `<limit>` (PyBullet's swing
+    /// and twist bounds, whose convention differs from the ball joint's cone) and its
+    /// `<dynamics>`, each with a warning.
+    fn spherical_unread(&self, node: Node<'_, '_>, damping: Real, friction: Real) {
+        let mut unread = Vec::new();
+        if child(node, "limit").is_some_and(|l| {
+            ["lower", "upper", "twist"]
+                .iter()
+                .any(|k| l.attribute(*k).is_some())
+        }) {
+            unread.push("limit: its bounds");
+        }
+        if damping > 0.0 || friction > 0.0 {
+            unread.push("dynamics: its damping and friction");
+        }
+        for what in unread {
+            self.warnings.borrow_mut().push(format!(
+                "{}: {what} are not applied to a spherical joint (a ball joint, free to turn)",
+                self.at(node)
+            ));
+        }
     }
 
     /// `<dynamics damping friction>`, both >= 0 (default 0).
