@@ -1257,3 +1257,60 @@ fn a_spherical_joint_is_a_ball_joint_and_its_pendulum_keeps_its_energy() {
         );
     }
 }
+
+#[test]
+fn pybullets_plane_geometry_is_a_static_plane_and_refused_on_a_moving_link() {
+    // plane_implicit.urdf's ground: `<plane normal="0 0 1"/>` on a massless root. Placed
+    // 0.3 m up and tilted about x by 0.2 rad, a ball dropped onto it comes to rest one
+    // radius from the tilted plane.
+    let d = dir("plane");
+    let text = r#"<robot name="plane"><link name="planeLink">
+  <inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>
+  <collision><origin xyz="0 0 0"/><geometry><plane normal="0 0 1"/></geometry></collision>
+</link></robot>"#;
+    let path = write(&d, "plane.urdf", text);
+    for (lift, tilt, radius) in [(0.0, 0.0, 0.5), (0.3, 0.2, 0.1), (-1.0, -0.1, 0.25)] {
+        let mut w = z_up();
+        let turn = tumble::Quat::from_rotation_x(tilt);
+        let opts = UrdfOptions {
+            fixed_base: false,
+            position: Vec3::new(0.0, 0.0, lift),
+            orientation: turn,
+            ..UrdfOptions::default()
+        };
+        let m = urdf::load(&path, &mut w, &opts).unwrap();
+        let ground = w.body(m.body("planeLink").unwrap()).unwrap();
+        assert_eq!(ground.shape().kind_name(), "plane");
+        let ball = w
+            .create_body(
+                &tumble::BodyDef {
+                    position: Vec3::new(0.0, 0.0, lift + 1.0),
+                    // Rolling resistance stops it rolling down the slope.
+                    rolling_resistance: 1.0,
+                    ..Default::default()
+                },
+                Shape::sphere(radius),
+            )
+            .unwrap();
+        for _ in 0..240 {
+            w.step(1.0 / 120.0).unwrap();
+        }
+        let up = turn * Vec3::Z;
+        let height = up.dot(w.body(ball).unwrap().position() - Vec3::new(0.0, 0.0, lift));
+        assert!(
+            (height - radius).abs() < 0.01,
+            "lift {lift}, tilt {tilt}: the ball rests {height} m from the plane"
+        );
+    }
+    // On a link that moves, a plane has no mass or volume to move with: refused.
+    let moving = text.replace(r#"<mass value="0"/>"#, r#"<mass value="1"/>"#);
+    let path = write(&d, "moving_plane.urdf", &moving);
+    let opts = UrdfOptions {
+        fixed_base: false,
+        ..UrdfOptions::default()
+    };
+    let e = urdf::load(&path, &mut z_up(), &opts)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("moving_plane.urdf:3: <collision>: geometry.plane: only a static link whose only collision geometry it is may be a plane"), "{e}");
+}

@@ -538,6 +538,16 @@ fn shape(
             Geometry::Capsule { radius, length } => {
                 (Shape::capsule(*radius, 0.5 * length), along_z)
             }
+            Geometry::Plane { normal } => {
+                if !is_static || all.len() != 1 {
+                    return Err(SceneError::new(
+                        format!("{}: geometry.plane", c.at),
+                        "only a static link whose only collision geometry it is may be a plane",
+                    ));
+                }
+                let normal = pose.rotation * *normal;
+                return Ok((Shape::plane(normal, normal.dot(pose.position)), true));
+            }
             Geometry::Mesh { file, scale } => {
                 let mesh = meshes.get(file, &c.at)?;
                 if is_static && all.len() == 1 {

@@ -88,6 +88,11 @@ pub(crate) enum Geometry {
         radius: Real,
         length: Real,
     },
+    /// PyBullet's extension: the plane through the origin with this unit normal, for a
+    /// static link whose only geometry it is.
+    Plane {
+        normal: Vec3,
+    },
     Mesh {
         file: PathBuf,
         scale: Vec3,
@@ -400,11 +405,19 @@ impl Cx<'_, '_> {
                 length: positive("length", "length")?,
             }),
             "mesh" => self.mesh(g),
+            "plane" => {
+                let normal = self.reals::<3>(g, "normal", "normal")?;
+                let normal = normal.map_or(Vec3::Z, Vec3::from_array);
+                match normal.try_normalize() {
+                    Some(normal) => Ok(Geometry::Plane { normal }),
+                    None => Err(self.err(g, "normal", "must be a non-zero direction")),
+                }
+            }
             other => Err(self.err(
                 g,
                 "",
                 format!(
-                    "unknown geometry '{}' (expected box, cylinder, sphere or mesh)",
+                    "unknown geometry '{}' (expected box, cylinder, sphere, capsule, mesh or plane)",
                     printable(other)
                 ),
             )),
