@@ -23,10 +23,10 @@
 //! rows was handed back and forth until it rang up from rounding to 400 rad/s within
 //! 0.6 s (59 J to 0.8 MJ in a second of falling onto the ground at dt = 0.01). Eight such
 //! children of equal mass and inertia is the least that did (seven grew by 1.7× in 0.6 s,
-//! six held); four passes held it up to 100 times the chassis's inertia. So a body whose
-//! joined partners' masses, or for joints that lock rotation their moments of inertia,
-//! sum to [`HUB_RATIO`] times its own, shared among several, makes its island heavy as well, with passes that
-//! grow with the load ([`hub_passes`]).
+//! six held); four passes held eight. So a body whose joined partners' masses, or for
+//! joints that lock rotation their moments of inertia, sum to [`HUB_RATIO`] times its own,
+//! shared among several, makes its island heavy as well, with passes that grow with the
+//! load ([`hub_passes`]).
 
 use super::body::BodySim;
 use crate::dynamics::island::{find, union};
