@@ -233,6 +233,12 @@ impl KindSpec {
         self.options.iter().any(|o| o.option == option)
     }
 
+    /// Whether the kind locks its bodies' relative rotation in some direction (hinge,
+    /// slider, fixed).
+    pub fn locks_rotation(&self) -> bool {
+        self.angular != AngularLock::Free
+    }
+
     /// The option keys it takes, in order.
     pub fn keys(&self) -> impl Iterator<Item = &'static str> + '_ {
         self.options.iter().map(|o| o.option.key())

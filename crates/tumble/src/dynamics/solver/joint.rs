@@ -201,7 +201,7 @@ impl JointConstraint {
     /// Whether the joint locks the bodies' relative rotation in some direction (hinge,
     /// slider, fixed): such joints keep their spring in islands with a hub (see `passes`).
     pub(super) fn locks_rotation(&self) -> bool {
-        self.spec.angular != AngularLock::Free
+        self.spec.locks_rotation()
     }
 
     /// Whether either of its bodies is flagged in `flags` (per body; empty: none is).

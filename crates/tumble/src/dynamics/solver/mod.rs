@@ -49,7 +49,7 @@ use crate::dynamics::body::Motion;
 use crate::dynamics::body::{Body, BodyKind};
 use crate::dynamics::force::Wrench;
 use crate::dynamics::integrate::{exact_spin, rotor_drift, System};
-use crate::dynamics::joint::{AngularLock, Joint};
+use crate::dynamics::joint::Joint;
 use crate::math::{Mat3, Real, Vec3};
 use crate::team::Parts;
 use crate::threads::Par;
@@ -484,7 +484,7 @@ impl Solver {
                 (true, [Some(a), Some(b)]) => Some(mass_ratio::Joined {
                     a,
                     b,
-                    locks_rotation: j.def.kind.spec().angular != AngularLock::Free,
+                    locks_rotation: j.def.kind.spec().locks_rotation(),
                 }),
                 _ => None,
             })
