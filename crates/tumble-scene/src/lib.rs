@@ -273,6 +273,7 @@ fn build(root: &Node<'_>, dir: &Path) -> Result<Scene> {
     if let Some(node) = obj.get("state") {
         restore_state(&node, &mut world, body_names.len())?;
     }
+    check_number_names(&world)?;
     Ok(Scene {
         name,
         description,
@@ -284,6 +285,35 @@ fn build(root: &Node<'_>, dir: &Path) -> Result<Scene> {
         character,
         warnings,
     })
+}
+
+/// Refuses a body or joint named with a plain number `k` (as imported models may name
+/// theirs) when the `k`-th body or joint is unnamed: output rows label an unnamed one by
+/// its index, so the two would read the same.
+fn check_number_names(world: &World) -> Result<()> {
+    fn clash<'a>(names: &[Option<&'a str>]) -> Option<&'a str> {
+        names.iter().flatten().copied().find(|name| {
+            !name.is_empty()
+                && name.bytes().all(|b| b.is_ascii_digit())
+                && name
+                    .parse::<usize>()
+                    .is_ok_and(|k| names.get(k) == Some(&None))
+        })
+    }
+    let bodies: Vec<Option<&str>> = world.bodies().map(|(_, b)| b.name()).collect();
+    let joints: Vec<Option<&str>> = world.joints().map(|(_, j)| j.name()).collect();
+    for (what, names) in [("body", bodies), ("joint", joints)] {
+        if let Some(name) = clash(&names) {
+            return Err(SceneError::new(
+                "models",
+                format!(
+                    "a model names a {what} '{name}', the label of the unnamed {what} at \
+                     index {name} (name that one, or give the model a prefix)"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The `state` section (a snapshot in hex, see `save.rs`) restored into the world built

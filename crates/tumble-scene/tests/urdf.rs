@@ -1314,3 +1314,117 @@ fn pybullets_plane_geometry_is_a_static_plane_and_refused_on_a_moving_link() {
         .to_string();
     assert!(e.contains("moving_plane.urdf:3: <collision>: geometry.plane: only a static link whose only collision geometry it is may be a plane"), "{e}");
 }
+
+#[test]
+fn numbered_names_xacro_defaults_and_stray_dots_load_as_pybullet_reads_them() {
+    // spirit40.urdf numbers its joints "0".."11"; husky.urdf keeps xacro's
+    // `$(optenv HUSKY_IMU_XYZ 0.19 0 0.149)`; biped2d_pybullet.urdf has lower="-1.57.".
+    let d = dir("numbered");
+    let text = "<robot name=\"r\">\n<link name=\"base\"><inertial><mass value=\"1\"/><inertia ixx=\"0.1\" iyy=\"0.1\" izz=\"0.1\"/></inertial></link>\n<link name=\"7\"><inertial><mass value=\"1\"/><inertia ixx=\"0.1\" iyy=\"0.1\" izz=\"0.1\"/></inertial></link>\n<joint name=\"8\" type=\"revolute\"><parent link=\"base\"/><child link=\"7\"/>\n<origin xyz=\"$(optenv R_XYZ 0.19 0 0.149)\"/><axis xyz=\"0 1 0\"/><limit lower=\"-1.57.\" upper=\"1.57\" effort=\"1\" velocity=\"1\"/></joint>\n</robot>\n";
+    let (w, m, shown) = warned(&d, "numbered.urdf", text, true);
+    assert_eq!(
+        shown,
+        [
+            "numbered.urdf:5: <limit>: limit.lower: '-1.57.' has stray dots; read as '-1.57', as PyBullet reads it",
+            "numbered.urdf:5: <origin>: origin.xyz: '$(optenv R_XYZ 0.19 0 0.149)' is xacro's optenv left unexpanded; its default '0.19 0 0.149' used",
+        ]
+    );
+    let child = w.body(m.body("7").unwrap()).unwrap();
+    assert!((child.position() - Vec3::new(0.19, 0.0, 0.149)).length() < EXACT);
+    let hinge = w.find_joint("8").expect("joint named 8");
+    let JointKind::Hinge { limits, .. } = w.joint(hinge).unwrap().kind() else {
+        panic!("not a hinge");
+    };
+    assert_eq!(*limits, Some([-1.57, 1.57]));
+    // Still refused: a number with other trailing text, an optenv without a default.
+    for (bad, why) in [
+        (
+            "-1.5x",
+            "limit.lower: expected 1 finite numbers, got '-1.5x'",
+        ),
+        ("1..", "limit.lower: expected 1 finite numbers, got '1..'"),
+    ] {
+        let p = write(&d, "bad.urdf", &text.replace("-1.57.", bad));
+        let e = urdf::load(&p, &mut z_up(), &UrdfOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.ends_with(why), "{e}");
+    }
+    let p = write(
+        &d,
+        "bad.urdf",
+        &text.replace("$(optenv R_XYZ 0.19 0 0.149)", "$(optenv R_XYZ)"),
+    );
+    let e = urdf::load(&p, &mut z_up(), &UrdfOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.ends_with("origin.xyz: expected 3 finite numbers, got '$(optenv R_XYZ)'"),
+        "{e}"
+    );
+
+    // In a scene, a numbered name is refused only where it reads as an unnamed body's or
+    // joint's index label.
+    let scene = |bodies: &str, prefix: &str| {
+        let s = format!(
+            r#"{{"bodies": [{bodies}], "models": [{{"file": "numbered.urdf", "prefix": "{prefix}"}}]}}"#
+        );
+        let p = write(&d, "scene.json", &s);
+        tumble_scene::load(p.to_str().unwrap())
+    };
+    let ball = r#"{"shape": {"type": "sphere", "radius": 0.1}, "position": [5, 0, 0]}"#;
+    let named =
+        r#"{"name": "b", "shape": {"type": "sphere", "radius": 0.1}, "position": [5, 0, 0]}"#;
+    let eight = vec![ball; 8].join(", ");
+    assert!(scene(ball, "").is_ok());
+    assert_eq!(
+        scene(&eight, "").unwrap_err().to_string(),
+        "models: a model names a body '7', the label of the unnamed body at index 7 (name that one, or give the model a prefix)"
+    );
+    assert!(scene(&eight, "m_").is_ok());
+    let mut seven_named = vec![ball; 7];
+    seven_named.push(named);
+    assert!(scene(&seven_named.join(", "), "").is_ok());
+}
+
+#[test]
+fn a_rods_tensor_on_a_link_without_geometry_is_made_possible_and_its_slider_holds() {
+    // biped2d_pybullet.urdf: 10 g sliders with a rod's tensor (principal moments 0,
+    // 0.215, 0.215; the zero comes out at 2e-18 of the others) and no collision geometry.
+    // Taken as given, the slider along y let its link fall along z.
+    let d = dir("rod_tensor");
+    let text = |tensor: &str| {
+        format!(
+            "<robot name=\"p\">\n<link name=\"base\"/>\n<link name=\"y\"><inertial><mass value=\"0.01\"/><inertia {tensor}/></inertial></link>\n<joint name=\"slide\" type=\"prismatic\"><parent link=\"base\"/><child link=\"y\"/><axis xyz=\"0 1 0\"/><limit lower=\"-1\" upper=\"1\" effort=\"0\" velocity=\"10\"/></joint>\n</robot>\n"
+        )
+    };
+    let rod =
+        "ixx=\"0.2125\" ixy=\"-0.005\" ixz=\"0.0225\" iyy=\"0.205\" iyz=\"0.045\" izz=\"0.0125\"";
+    let (mut w, m, shown) = warned(&d, "rod.urdf", &text(rod), true);
+    assert_eq!(shown.len(), 1, "{shown:?}");
+    assert!(
+        shown[0].contains("<link name=\"y\">: inertial.inertia: is not positive definite")
+            && shown[0].contains("raised to at least 0.001 of the largest"),
+        "{}",
+        shown[0]
+    );
+    let y = m.body("y").unwrap();
+    let (moments, _) = w.body(y).unwrap().principal_inertia();
+    let mut sorted = moments.to_array();
+    sorted.sort_by(Real::total_cmp);
+    // Raised to a thousandth of the largest; the other two as the file has them.
+    let tol = if F32 { 1e-5 } else { 1e-9 };
+    for (got, want) in sorted.iter().zip([0.000215, 0.215, 0.215]) {
+        assert!((got - want).abs() < tol, "{sorted:?}");
+    }
+    // A second at dt 1/240 under z gravity: the slider holds it at z = 0 (to the joint's
+    // softness, well under a millimetre) while nothing pushes it along y.
+    for _ in 0..240 {
+        w.step(1.0 / 240.0);
+    }
+    let p = w.body(y).unwrap().position();
+    assert!(
+        p.z.abs() < 1e-3 && p.x.abs() < 1e-6 && p.y.abs() < 1e-6,
+        "{p}"
+    );
+}

@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use tumble::shape::{CompoundChild, MassProperties, TriMesh};
 use tumble::{
     BodyDef, BodyId, BodyKind, InertiaSpec, JointCoordinate, JointDef, JointId, JointKind,
-    MassSpec, Motor, Quat, Real, Servo, Shape, Vec3, World,
+    MassSpec, Mat3, Motor, Quat, Real, Servo, Shape, Vec3, World,
 };
 
 use super::parse::{Geometry, JointType, Model, Pose};
@@ -444,6 +444,13 @@ fn body(
                 ));
                 continue;
             }
+            (Some(tensor), Some(problem)) if link.collisions.is_empty() => {
+                warnings.push(format!(
+                    "{}: inertial.inertia: {problem}; the link has no collision geometry to take one from, so its principal moments are raised to at least {} of the largest",
+                    link.at, LEAST_MOMENT
+                ));
+                possible(tensor)
+            }
             (Some(_), Some(problem)) => {
                 warnings.push(format!(
                     "{}: inertial.inertia: {problem}; taken from the collision geometry at uniform density, as PyBullet does",
@@ -503,6 +510,24 @@ fn body(
         def,
         shape,
     })
+}
+
+/// The least principal moment [`possible`] leaves, as a share of the largest.
+const LEAST_MOMENT: Real = 1e-3;
+
+/// The nearest tensor to `t` that the engine takes as a body's: the same principal axes,
+/// each moment raised to at least [`LEAST_MOMENT`] of the largest, and the largest
+/// lowered to the sum of the other two where it exceeded it. For a link without
+/// collision geometry whose file tensor is impossible (biped2d_pybullet.urdf's sliders
+/// give a rod's, one moment zero): a 1 cm placeholder sphere's instead would make the
+/// link 10⁶ times lighter to turn than the file says.
+fn possible(t: Mat3) -> Mat3 {
+    let (moments, axes) = tumble::math::symmetric_eigen(t);
+    let largest = moments.max_element().max(Real::MIN_POSITIVE);
+    let raised = moments.max(Vec3::splat(LEAST_MOMENT * largest));
+    let [a, b, c] = raised.to_array();
+    let fitted = Vec3::new(a.min(b + c), b.min(a + c), c.min(a + b));
+    axes * Mat3::from_diagonal(fitted) * axes.transpose()
 }
 
 /// The group's collision geometry in the frame of its first link, and whether it has

@@ -231,8 +231,16 @@ impl Cx<'_, '_> {
         let Some(text) = node.attribute(attr) else {
             return Ok(None);
         };
+        let (read, why) = numbers_as_pybullet_reads(text);
+        if let Some(why) = why {
+            self.warnings.borrow_mut().push(format!(
+                "{}: {field}: '{}' {why}",
+                self.at(node),
+                printable(text)
+            ));
+        }
         // Whitespace separates, as the format says; commas too, as PyBullet allows.
-        let words: Vec<&str> = text
+        let words: Vec<&str> = read
             .split(|c: char| c.is_whitespace() || c == ',')
             .filter(|w| !w.is_empty())
             .collect();
@@ -275,8 +283,13 @@ impl Cx<'_, '_> {
         let name = node
             .attribute("name")
             .ok_or_else(|| self.err(node, "name", "is required"))?;
-        crate::body::check_name(name, "links and joints")
-            .map_err(|reason| self.err(node, "name", reason))?;
+        // Plain numbers are names in published files (spirit40.urdf numbers its joints);
+        // the scene checks that none reads as an unnamed body's or joint's index label.
+        let number = !name.is_empty() && name.bytes().all(|b| b.is_ascii_digit());
+        if !number {
+            crate::body::check_name(name, "links and joints")
+                .map_err(|reason| self.err(node, "name", reason))?;
+        }
         Ok(name.to_string())
     }
 
@@ -575,14 +588,23 @@ fn zero_mass(origin: Pose) -> Inertial {
 
 /// Why `m` is not a possible inertia tensor, if it is not: it must be positive definite,
 /// with no principal moment above the sum of the other two (with a relative slack of
-/// 1e-6 for files that round their moments to a few digits).
+/// 1e-6 for files that round their moments to a few digits). A moment under
+/// [`ZERO_MOMENT`] of the largest counts as zero: biped2d_pybullet.urdf's sliders carry
+/// a rod's tensor whose smallest moment comes out at 2e-18 of the others, and a body
+/// that light about one axis made its joints let go (the slider fell through its axis).
+/// The share of the largest principal moment below which a moment counts as zero: the
+/// eigen solve leaves a moment meant to be zero at a few ε of the others (2e-18 in f64
+/// for that slider, 1e-7 in f32); a needle a micrometre thick and a metre long is at
+/// 6e-12, above this in f64.
+const ZERO_MOMENT: Real = 64.0 * Real::EPSILON;
+
 fn tensor_problem(m: Mat3) -> Option<String> {
     let (moments, _) = symmetric_eigen(m);
     let mut sorted = moments.to_array();
     sorted.sort_by(Real::total_cmp);
     let [a, b, c] = sorted.map(short);
     let list = format!("principal moments [{a}, {b}, {c}]");
-    if moments.min_element() <= 0.0 {
+    if moments.min_element() <= ZERO_MOMENT * moments.max_element() {
         return Some(format!("is not positive definite: its {list}"));
     }
     let sum = moments.x + moments.y + moments.z;
@@ -683,4 +705,55 @@ pub(crate) fn resolve(name: &str, dir: &Path) -> Option<PathBuf> {
         dir.join(path)
     };
     path.is_file().then_some(path)
+}
+
+/// The numbers text of an attribute as PyBullet's reader takes it, and why it differs
+/// from the text when it does. Two slips seen in published files are read as PyBullet
+/// reads them: xacro's `$(optenv NAME default...)` left unexpanded (husky.urdf) gives its
+/// default (PyBullet reads no environment, and neither do we: a file loads the same
+/// everywhere), and a number with stray trailing dots (`-1.57.`, biped2d_pybullet.urdf)
+/// is read up to them, as a C++ stream reads it. Anything else is left for the caller to
+/// refuse.
+fn numbers_as_pybullet_reads(text: &str) -> (std::borrow::Cow<'_, str>, Option<String>) {
+    let trimmed = text.trim();
+    if let Some(inner) = trimmed
+        .strip_prefix("$(optenv")
+        .and_then(|rest| rest.strip_suffix(')'))
+    {
+        let mut words = inner.split_whitespace();
+        if words.next().is_some() {
+            let default = words.collect::<Vec<_>>().join(" ");
+            let why = format!(
+                "is xacro's optenv left unexpanded; its default '{}' used",
+                printable(&default)
+            );
+            return (default.into(), Some(why));
+        }
+    }
+    let stray = |w: &str| w.len() > 1 && w.ends_with('.') && w.trim_end_matches('.').contains('.');
+    if text
+        .split(|c: char| c.is_whitespace() || c == ',')
+        .any(stray)
+    {
+        let read: String = text
+            .split_inclusive(|c: char| c.is_whitespace() || c == ',')
+            .map(|w| {
+                let (word, sep) = w.split_at(
+                    w.trim_end_matches(|c: char| c.is_whitespace() || c == ',')
+                        .len(),
+                );
+                if stray(word) {
+                    format!("{}{sep}", word.trim_end_matches('.'))
+                } else {
+                    w.to_string()
+                }
+            })
+            .collect();
+        let why = format!(
+            "has stray dots; read as '{}', as PyBullet reads it",
+            printable(&read)
+        );
+        return (read.into(), Some(why));
+    }
+    (text.into(), None)
 }
