@@ -271,6 +271,23 @@ fn impossible_bodies_are_refused_with_the_field_named() {
         Shape::sphere(1.0)
     )
     .starts_with("inertia: violates the triangle inequality"));
+    // A rod's tensor with off-diagonal terms (PyBullet's biped2d sliders): principal
+    // moments 0.215, 0.215 and zero to rounding, which must not pass as positive.
+    let rod = Mat3::from_cols(
+        Vec3::new(0.2125, -0.005, 0.0225),
+        Vec3::new(-0.005, 0.205, 0.045),
+        Vec3::new(0.0225, 0.045, 0.0125),
+    );
+    assert_eq!(
+        err(
+            BodyDef {
+                inertia: Some(InertiaSpec::Tensor(rod)),
+                ..Default::default()
+            },
+            Shape::sphere(1.0)
+        ),
+        "inertia: must be positive definite"
+    );
     let skewed = Mat3::from_cols(
         Vec3::new(1.0, 0.5, 0.0),
         Vec3::new(0.0, 1.0, 0.0),
