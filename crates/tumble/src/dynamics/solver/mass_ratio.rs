@@ -82,6 +82,10 @@ fn mean_moment(s: &BodySim) -> Real {
 /// heavy partner is a pair's ratio, cured as such), and the largest such load; `None`
 /// when no body does, found in one scan of the joints.
 fn hubs(sims: &[BodySim], joined: &[Joined]) -> Option<(Vec<bool>, Real)> {
+    // Without joints there is no hub, and no per-body scratch to fill (the rain's 2,000).
+    if joined.is_empty() {
+        return None;
+    }
     let moving = |k: usize| sims[k].moves;
     // Per body: [sum, largest] of the partners' mass ratios, then of their moment ratios.
     let mut load = vec![[0.0 as Real; 4]; sims.len()];

@@ -38,7 +38,7 @@ pub use settings::{SolverKind, SolverSettings};
 use softness::LoadSpring;
 pub use softness::Softness;
 
-use body::BODIES_A_PIECE;
+pub(crate) use body::BODIES_A_PIECE;
 pub(crate) use body::{BodySim, BodyState, SolverBodies};
 use contact::{BiasRule, ContactConstraint, PairData, Points};
 use joint::{Block as JointBlock, Frame as JointFrame, JointConstraint, JointPass};

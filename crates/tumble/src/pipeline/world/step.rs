@@ -75,6 +75,8 @@ pub(crate) struct StepContext {
     /// The moved proxies' new tight boxes and displacements, handed to the broad phase
     /// together.
     proxy_updates: Vec<(crate::collision::broad_phase::ProxyId, Aabb, Vec3)>,
+    /// Per body, its proxy update (`None`: static or asleep), filled in pieces.
+    body_updates: Vec<Option<(crate::collision::broad_phase::ProxyId, Aabb, Vec3)>>,
     /// How this step may split its work (see `threads.rs`).
     pub par: Par,
 }
@@ -293,24 +295,32 @@ impl World {
     fn scatter(&mut self) {
         let ctx = &mut self.scratch;
         let c = &mut self.collision;
+        let (sims, states, proxies) = (&ctx.bodies.sims, &ctx.bodies.states, &c.proxies);
+        let n = self.bodies.list.len();
+        ctx.body_updates.resize(n, None);
+        // In pieces on the step's team: one after another it was 0.17 ms of the rain's
+        // step on two threads (a box and five writes a body).
+        let size = n.div_ceil(ctx.par.pieces(n, crate::dynamics::solver::BODIES_A_PIECE));
+        let pair = (&mut self.bodies.list[..], &mut ctx.body_updates[..]);
+        crate::team::chunks2(ctx.par.threads, pair, size, &|start, bodies, updates| {
+            for (j, (body, update)) in bodies.iter_mut().zip(updates).enumerate() {
+                let (sim, state) = (&sims[start + j], &states[start + j]);
+                *update = (body.kind != BodyKind::Static && body.awake).then(|| {
+                    let moved = sim.x - body.com;
+                    let pose = Pose::new(sim.x - sim.q * body.local_center, sim.q);
+                    (proxies[start + j], body.shape.aabb(&pose), moved)
+                });
+                body.com = sim.x;
+                body.orientation = sim.q;
+                body.velocity = state.v;
+                body.angular_momentum = sim.l;
+                body.angular_velocity = state.w;
+            }
+        });
         // Handed to the broad phase together: it may rebuild its tree rather than move
         // most of its leaves one by one.
         ctx.proxy_updates.clear();
-        let states = ctx.bodies.sims.iter().zip(&ctx.bodies.states);
-        for ((body, (sim, state)), proxy) in self.bodies.list.iter_mut().zip(states).zip(&c.proxies)
-        {
-            if body.kind != BodyKind::Static && body.awake {
-                let moved = sim.x - body.com;
-                let pose = Pose::new(sim.x - sim.q * body.local_center, sim.q);
-                ctx.proxy_updates
-                    .push((*proxy, body.shape.aabb(&pose), moved));
-            }
-            body.com = sim.x;
-            body.orientation = sim.q;
-            body.velocity = state.v;
-            body.angular_momentum = sim.l;
-            body.angular_velocity = state.w;
-        }
+        ctx.proxy_updates.extend(ctx.body_updates.iter().flatten());
         c.broad_phase.update_many(&ctx.proxy_updates);
     }
 
