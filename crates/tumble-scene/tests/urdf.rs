@@ -1375,7 +1375,7 @@ fn numbered_names_xacro_defaults_and_stray_dots_load_as_pybullet_reads_them() {
     let ball = r#"{"shape": {"type": "sphere", "radius": 0.1}, "position": [5, 0, 0]}"#;
     let named =
         r#"{"name": "b", "shape": {"type": "sphere", "radius": 0.1}, "position": [5, 0, 0]}"#;
-    let eight = vec![ball; 8].join(", ");
+    let eight = [ball; 8].join(", ");
     assert!(scene(ball, "").is_ok());
     assert_eq!(
         scene(&eight, "").unwrap_err().to_string(),
@@ -1420,7 +1420,7 @@ fn a_rods_tensor_on_a_link_without_geometry_is_made_possible_and_its_slider_hold
     // A second at dt 1/240 under z gravity: the slider holds it at z = 0 (to the joint's
     // softness, well under a millimetre) while nothing pushes it along y.
     for _ in 0..240 {
-        w.step(1.0 / 240.0);
+        w.step(1.0 / 240.0).unwrap();
     }
     let p = w.body(y).unwrap().position();
     assert!(
