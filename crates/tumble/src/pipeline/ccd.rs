@@ -22,7 +22,7 @@
 //!   out of its far side. Such sweeps, which start touching, were ignored (stopping them at
 //!   t = 0 froze a ragdoll's forearm lying on a stair while its elbow pulled it up at
 //!   12 m/s), so all of this went through: of the 3,840 shots of
-//!   `tests/continuous_collision.rs`, 820 ended with the centre behind the wall's face.
+//!   `tests/engine/continuous_collision.rs`, 820 ended with the centre behind the wall's face.
 //!   Now the sweep stops where the body would get deeper than `depth` (the slop, or a
 //!   quarter of the body's thickness if that is less), or, already deeper, deeper than it
 //!   is plus a tenth of that, and never past a floor at three eighths of its thickness, so

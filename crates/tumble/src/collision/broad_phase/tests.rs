@@ -1,5 +1,5 @@
 //! Unit tests of the tree's invariants and the broad phase's bookkeeping; the behaviour
-//! against brute force is tested in `tests/broad_phase.rs`.
+//! against brute force is tested in `tests/engine/broad_phase.rs`.
 
 use super::tree::Tree;
 use super::*;

@@ -25,7 +25,7 @@
 //! friction force F at the contact and the rolling torque τ = μ_r r N against its turning:
 //! m v̇ = −F, I ω̇ = r F − μ_r r N, v = r ω, so v̇ (m + I/r²) = −μ_r N and
 //! a = μ_r g / (1 + I/(m r²)) = (5/7) μ_r g. A ball spinning about the normal on its point of
-//! contact slows at ω̇ = μ_t m g / I. Both are measured in `tests/rolling_friction.rs`.
+//! contact slows at ω̇ = μ_t m g / I. Both are measured in `tests/engine/rolling_friction.rs`.
 
 use super::body::BodySim;
 use super::contact::Point;

@@ -53,7 +53,7 @@ pub(crate) const HUB_PASSES: u32 = 16;
 
 /// The passes a hub's island gets for the largest load (see [`HUB_RATIO`]): √load + 1,
 /// from four (at a load of 6 to 9) to [`HUB_PASSES`]. Measured in zero gravity from a
-/// small spin (tests/joints.rs): eight partners of the chassis's inertia held with 4;
+/// small spin (tests/engine/joints.rs): eight partners of the chassis's inertia held with 4;
 /// twelve of ten times it (a load of 120) still gained 1 % at 8 passes and held at 12,
 /// as did six of a hundred times; sixteen of ten times (160) rang at 12 and held at 14.
 /// Twenty-four of a hundred times (800) rang even at 16: more passes are not a cure
