@@ -586,18 +586,18 @@ fn zero_mass(origin: Pose) -> Inertial {
     }
 }
 
+/// The share of the largest principal moment below which a moment counts as zero: the
+/// eigen solve leaves a moment meant to be zero at a few ε of the others (2e-18 in f64
+/// for biped2d's sliders, 1e-7 in f32); a needle a micrometre thick and a metre long is
+/// at 6e-12, above this in f64. The engine refuses such a tensor too.
+const ZERO_MOMENT: Real = 64.0 * Real::EPSILON;
+
 /// Why `m` is not a possible inertia tensor, if it is not: it must be positive definite,
 /// with no principal moment above the sum of the other two (with a relative slack of
 /// 1e-6 for files that round their moments to a few digits). A moment under
 /// [`ZERO_MOMENT`] of the largest counts as zero: biped2d_pybullet.urdf's sliders carry
 /// a rod's tensor whose smallest moment comes out at 2e-18 of the others, and a body
 /// that light about one axis made its joints let go (the slider fell through its axis).
-/// The share of the largest principal moment below which a moment counts as zero: the
-/// eigen solve leaves a moment meant to be zero at a few ε of the others (2e-18 in f64
-/// for that slider, 1e-7 in f32); a needle a micrometre thick and a metre long is at
-/// 6e-12, above this in f64.
-const ZERO_MOMENT: Real = 64.0 * Real::EPSILON;
-
 fn tensor_problem(m: Mat3) -> Option<String> {
     let (moments, _) = symmetric_eigen(m);
     let mut sorted = moments.to_array();
