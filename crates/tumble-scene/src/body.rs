@@ -106,6 +106,12 @@ pub(crate) fn name(obj: &Obj<'_>, of: &str) -> Result<Option<String>> {
     Ok(Some(name.to_string()))
 }
 
+/// Whether `name` is digits only (and not empty): what an unnamed body's or joint's label
+/// looks like.
+pub(crate) fn is_plain_number(name: &str) -> bool {
+    !name.is_empty() && name.bytes().all(|b| b.is_ascii_digit())
+}
+
 /// Why `name` cannot name one of `of` (`"bodies"` or `"joints"`), or `Ok`. Names label
 /// CSV rows and messages, where unnamed bodies and joints are labelled by their index: a
 /// name of digits could be mistaken for another's index, an empty one reads as a missing
@@ -118,7 +124,7 @@ pub fn check_name(name: &str, of: &str) -> std::result::Result<(), String> {
     if name.chars().any(char::is_control) {
         return Err("must not contain control characters".into());
     }
-    if name.bytes().all(|b| b.is_ascii_digit()) {
+    if is_plain_number(name) {
         return Err(format!(
             "must not be a plain number (unnamed {of} are labelled by their index)"
         ));

@@ -293,8 +293,7 @@ fn build(root: &Node<'_>, dir: &Path) -> Result<Scene> {
 fn check_number_names(world: &World) -> Result<()> {
     fn clash<'a>(names: &[Option<&'a str>]) -> Option<&'a str> {
         names.iter().flatten().copied().find(|name| {
-            !name.is_empty()
-                && name.bytes().all(|b| b.is_ascii_digit())
+            body::is_plain_number(name)
                 && name
                     .parse::<usize>()
                     .is_ok_and(|k| names.get(k) == Some(&None))

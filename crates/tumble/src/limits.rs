@@ -27,6 +27,13 @@ pub const MAX_MASS: Real = 1e15;
 pub const MIN_MOMENT: Real = 1e-30;
 /// See [`MIN_MOMENT`].
 pub const MAX_MOMENT: Real = 1e30;
+/// The share of a tensor's largest principal moment at or below which another counts as
+/// zero (not positive definite): the eigen solve leaves a moment meant to be zero at a few
+/// ε of the others (a rod's tensor written with off-diagonal terms, PyBullet's biped2d
+/// sliders: 2e-18 in f64, 1e-7 in f32); a needle a micrometre thick and a metre long is at
+/// 6e-12, above this in f64. Accepted, such a body was too light to turn for a slider
+/// joint to hold it along its locked axes.
+pub const ZERO_MOMENT_SHARE: Real = 64.0 * Real::EPSILON;
 /// Largest accepted frequency of a soft constraint or spring (Hz): far beyond any step's
 /// resolution (1/dt), where the soft constraint is already rigid.
 pub const MAX_HERTZ: Real = 1e6;

@@ -239,11 +239,7 @@ impl Cx<'_, '_> {
                 printable(text)
             ));
         }
-        // Whitespace separates, as the format says; commas too, as PyBullet allows.
-        let words: Vec<&str> = read
-            .split(|c: char| c.is_whitespace() || c == ',')
-            .filter(|w| !w.is_empty())
-            .collect();
+        let words: Vec<&str> = read.split(is_separator).filter(|w| !w.is_empty()).collect();
         let nums: Vec<Real> = words
             .iter()
             .filter_map(|w| w.parse::<Real>().ok().filter(|x| x.is_finite()))
@@ -285,8 +281,7 @@ impl Cx<'_, '_> {
             .ok_or_else(|| self.err(node, "name", "is required"))?;
         // Plain numbers are names in published files (spirit40.urdf numbers its joints);
         // the scene checks that none reads as an unnamed body's or joint's index label.
-        let number = !name.is_empty() && name.bytes().all(|b| b.is_ascii_digit());
-        if !number {
+        if !crate::body::is_plain_number(name) {
             crate::body::check_name(name, "links and joints")
                 .map_err(|reason| self.err(node, "name", reason))?;
         }
@@ -586,16 +581,10 @@ fn zero_mass(origin: Pose) -> Inertial {
     }
 }
 
-/// The share of the largest principal moment below which a moment counts as zero: the
-/// eigen solve leaves a moment meant to be zero at a few ε of the others (2e-18 in f64
-/// for biped2d's sliders, 1e-7 in f32); a needle a micrometre thick and a metre long is
-/// at 6e-12, above this in f64. The engine refuses such a tensor too.
-const ZERO_MOMENT: Real = 64.0 * Real::EPSILON;
-
 /// Why `m` is not a possible inertia tensor, if it is not: it must be positive definite,
 /// with no principal moment above the sum of the other two (with a relative slack of
-/// 1e-6 for files that round their moments to a few digits). A moment under
-/// [`ZERO_MOMENT`] of the largest counts as zero: biped2d_pybullet.urdf's sliders carry
+/// 1e-6 for files that round their moments to a few digits). A moment at or under the
+/// engine's [`tumble::limits::ZERO_MOMENT_SHARE`] of the largest counts as zero: biped2d_pybullet.urdf's sliders carry
 /// a rod's tensor whose smallest moment comes out at 2e-18 of the others, and a body
 /// that light about one axis made its joints let go (the slider fell through its axis).
 fn tensor_problem(m: Mat3) -> Option<String> {
@@ -604,7 +593,7 @@ fn tensor_problem(m: Mat3) -> Option<String> {
     sorted.sort_by(Real::total_cmp);
     let [a, b, c] = sorted.map(short);
     let list = format!("principal moments [{a}, {b}, {c}]");
-    if moments.min_element() <= ZERO_MOMENT * moments.max_element() {
+    if moments.min_element() <= tumble::limits::ZERO_MOMENT_SHARE * moments.max_element() {
         return Some(format!("is not positive definite: its {list}"));
     }
     let sum = moments.x + moments.y + moments.z;
@@ -731,17 +720,11 @@ fn numbers_as_pybullet_reads(text: &str) -> (std::borrow::Cow<'_, str>, Option<S
         }
     }
     let stray = |w: &str| w.len() > 1 && w.ends_with('.') && w.trim_end_matches('.').contains('.');
-    if text
-        .split(|c: char| c.is_whitespace() || c == ',')
-        .any(stray)
-    {
+    if text.split(is_separator).any(stray) {
         let read: String = text
-            .split_inclusive(|c: char| c.is_whitespace() || c == ',')
+            .split_inclusive(is_separator)
             .map(|w| {
-                let (word, sep) = w.split_at(
-                    w.trim_end_matches(|c: char| c.is_whitespace() || c == ',')
-                        .len(),
-                );
+                let (word, sep) = w.split_at(w.trim_end_matches(is_separator).len());
                 if stray(word) {
                     format!("{}{sep}", word.trim_end_matches('.'))
                 } else {
@@ -756,4 +739,10 @@ fn numbers_as_pybullet_reads(text: &str) -> (std::borrow::Cow<'_, str>, Option<S
         return (read.into(), Some(why));
     }
     (text.into(), None)
+}
+
+/// What separates the numbers of an attribute: whitespace, as the format says; commas
+/// too, as PyBullet allows.
+fn is_separator(c: char) -> bool {
+    c.is_whitespace() || c == ','
 }

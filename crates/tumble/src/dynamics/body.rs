@@ -684,10 +684,7 @@ pub(crate) fn validate_inertia(spec: InertiaSpec) -> Result<Mat3> {
         }
     };
     let (moments, _) = crate::math::symmetric_eigen(m);
-    // A moment within rounding of zero (a few ε of the largest: a rod's tensor written
-    // with off-diagonal terms comes out at 2e-18 in f64) is zero: a body that light to
-    // turn made a slider joint let go of it along its locked axes.
-    if moments.min_element() <= 64.0 * Real::EPSILON * moments.max_element() {
+    if moments.min_element() <= crate::limits::ZERO_MOMENT_SHARE * moments.max_element() {
         return Err(Error::invalid("inertia", "must be positive definite"));
     }
     let sum = moments.x + moments.y + moments.z;
