@@ -33,6 +33,8 @@
 
 #[path = "joint_block.rs"]
 mod block;
+#[path = "joint_chain.rs"]
+mod chain;
 #[path = "joint_1d.rs"]
 mod one_d;
 #[path = "joint_rows.rs"]
@@ -44,6 +46,7 @@ use crate::dynamics::joint::{AngularLock, Joint, JointImpulses, KindSpec, Linear
 use crate::math::{Mat3, Quat, Real, Vec3};
 pub(crate) use block::Block;
 use block::{apply_point, point_impulse, point_inverse_mass, solve_hard, solve_point};
+pub(crate) use chain::{find_chains, Chain, ChainBlock};
 use one_d::{free_impulse, solve_free, solve_limit, FreeDrive};
 
 /// A body as a joint sees it: pose, inverse masses, whether it moves. The world is one
@@ -181,6 +184,9 @@ pub(crate) struct JointConstraint {
     /// frame, see `block::Block`); `None` for joints without hard rows solved as a block
     /// (ball and distance joints).
     pub block: Option<usize>,
+    /// The chain of joints through light bodies this joint belongs to (see
+    /// `joint_chain.rs`), whose block solves its hard rows instead of its own.
+    pub chain: Option<usize>,
 }
 
 /// Where the geometry of a joint stands at the bodies' current poses. Poses change only
@@ -241,6 +247,7 @@ impl JointConstraint {
             point_mass: None,
             plain_ball,
             block: None,
+            chain: None,
         }
     }
 
@@ -381,7 +388,10 @@ impl JointConstraint {
         let drive = self.drive;
         let free = self.free_row(fr);
         let cone = self.cone_row(fr);
-        let hard = self.block(fr, blocks);
+        let hard = match self.chain {
+            Some(_) => None,
+            None => self.block(fr, blocks),
+        };
         let point_mass = self.point_apart().then(|| {
             *self
                 .point_mass

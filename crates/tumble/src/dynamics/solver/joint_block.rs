@@ -140,26 +140,68 @@ impl HardRows {
 /// each pass did before: K's build and elimination were 36 % of a cart-pole's step, made
 /// twice per frame). A vanishing pivot (a direction no body can move in, such as out of a
 /// planar body's plane) leaves that unknown zero.
-#[derive(Clone, Default)]
-pub(super) struct Eliminated {
+/// The numbers an [`Eliminated`] works in: `Real` for a joint's block, f64 for a chain's,
+/// whose light bodies make K too ill-conditioned for f32 (see `joint_chain.rs`).
+pub(super) trait Element:
+    Copy
+    + PartialOrd
+    + std::ops::Sub<Output = Self>
+    + std::ops::Mul<Output = Self>
+    + std::ops::Div<Output = Self>
+    + std::ops::SubAssign
+    + std::iter::Sum
+{
+    const ZERO: Self;
+    /// A pivot at most this share of K's largest diagonal entry counts as zero.
+    const TINY: Self;
+    fn abs(self) -> Self;
+    fn max(self, other: Self) -> Self;
+    fn total_cmp(&self, other: &Self) -> std::cmp::Ordering;
+}
+
+macro_rules! element {
+    ($t:ty) => {
+        impl Element for $t {
+            const ZERO: $t = 0.0;
+            const TINY: $t = 1e-12;
+            fn abs(self) -> $t {
+                <$t>::abs(self)
+            }
+            fn max(self, other: $t) -> $t {
+                <$t>::max(self, other)
+            }
+            fn total_cmp(&self, other: &$t) -> std::cmp::Ordering {
+                <$t>::total_cmp(self, other)
+            }
+        }
+    };
+}
+element!(f32);
+element!(f64);
+
+#[derive(Clone)]
+pub(super) struct Eliminated<const N: usize = 6, T: Element = Real> {
     /// The upper triangle left by the elimination.
-    k: [[Real; 6]; 6],
+    k: [[T; N]; N],
     /// Per column, the row swapped into the pivot's place, and the multipliers of the
     /// rows below it.
-    pivot: [usize; 6],
-    factor: [[Real; 6]; 6],
-    skip: [bool; 6],
+    pivot: [usize; N],
+    factor: [[T; N]; N],
+    skip: [bool; N],
     n: usize,
 }
 
-impl Eliminated {
-    /// Eliminates the n×n matrix `k`.
-    fn new(mut k: [[Real; 6]; 6], n: usize) -> Eliminated {
-        let scale = (0..n).map(|i| k[i][i].abs()).fold(0.0, Real::max);
-        let tiny = 1e-12 * scale;
+impl<const N: usize, T: Element> Eliminated<N, T> {
+    /// Eliminates the n×n matrix `k` (n ≤ N).
+    pub(super) fn new(mut k: [[T; N]; N], n: usize) -> Eliminated<N, T> {
+        let scale = (0..n).map(|i| k[i][i].abs()).fold(T::ZERO, T::max);
+        let tiny = T::TINY * scale;
         let mut e = Eliminated {
+            k: [[T::ZERO; N]; N],
+            pivot: [0; N],
+            factor: [[T::ZERO; N]; N],
+            skip: [false; N],
             n,
-            ..Eliminated::default()
         };
         for col in 0..n {
             let pivot = (col..n)
@@ -176,7 +218,7 @@ impl Eliminated {
             for (row, factor) in below {
                 let f = row[col] / pivot_row[col];
                 for (kij, pj) in row[col..n].iter_mut().zip(&pivot_row[col..n]) {
-                    *kij -= f * pj;
+                    *kij -= f * *pj;
                 }
                 *factor = f;
             }
@@ -186,7 +228,7 @@ impl Eliminated {
     }
 
     /// x with K x = `rhs`.
-    fn solve(&self, mut rhs: [Real; 6]) -> [Real; 6] {
+    pub(super) fn solve(&self, mut rhs: [T; N]) -> [T; N] {
         let (k, n) = (&self.k, self.n);
         for col in 0..n {
             rhs.swap(col, self.pivot[col]);
@@ -197,15 +239,21 @@ impl Eliminated {
                 rhs[i] -= self.factor[col][i] * rhs[col];
             }
         }
-        let mut x = [0.0; 6];
+        let mut x = [T::ZERO; N];
         for i in (0..n).rev() {
             if self.skip[i] {
                 continue;
             }
-            let sum: Real = (i + 1..n).map(|j| k[i][j] * x[j]).sum();
+            let sum: T = (i + 1..n).map(|j| k[i][j] * x[j]).sum();
             x[i] = (rhs[i] - sum) / k[i][i];
         }
         x
+    }
+}
+
+impl Default for Eliminated {
+    fn default() -> Self {
+        Eliminated::new([[0.0; 6]; 6], 0)
     }
 }
 

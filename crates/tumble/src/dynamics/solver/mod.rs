@@ -41,7 +41,10 @@ pub use softness::Softness;
 pub(crate) use body::BODIES_A_PIECE;
 pub(crate) use body::{BodySim, BodyState, SolverBodies};
 use contact::{BiasRule, ContactConstraint, PairData, Points};
-use joint::{Block as JointBlock, Frame as JointFrame, JointConstraint, JointPass};
+use joint::{
+    find_chains, Block as JointBlock, Chain, ChainBlock, Frame as JointFrame, JointConstraint,
+    JointPass,
+};
 
 use crate::collision::contact::{Contact, ContactMaterial};
 use crate::collision::narrow_phase::Overlap;
@@ -91,6 +94,11 @@ pub(crate) struct Solver {
     /// where), each made at its first use at the current frames: emptied after each
     /// drift.
     joint_blocks: Vec<Option<JointBlock>>,
+    /// Chains of joints through light bodies, solved as one block each (see
+    /// `joint_chain.rs`), and their blocks at the current frames (emptied with
+    /// `joint_blocks`).
+    chains: Vec<Chain>,
+    chain_blocks: Vec<Option<ChainBlock>>,
     /// Per body, whether its island has a large mass ratio (see `mass_ratio`); empty when
     /// none has. Such islands' contacts and joints sit at the end of their lists, from
     /// `heavy_contacts` and `heavy_joints`, and get `heavy_passes` times the passes.
@@ -324,14 +332,26 @@ impl Solver {
         ];
         for (contacts, joints, count, (rule, joint_pass, locked_pass)) in parts {
             for k in 0..count {
-                let frames = &self.joint_frames[joints.clone()];
-                for (j, fr) in self.joints[joints.clone()].iter_mut().zip(frames) {
-                    let pass = if j.locks_rotation() && j.on(&self.hub) {
+                let hub = &self.hub;
+                let pass = |j: &JointConstraint| {
+                    if j.locks_rotation() && j.on(hub) {
                         locked_pass
                     } else {
                         joint_pass
-                    };
-                    j.solve(fr, &mut bodies.states, pass, &mut self.joint_blocks);
+                    }
+                };
+                for i in joints.clone() {
+                    let (j, fr) = (&mut self.joints[i], &self.joint_frames[i]);
+                    j.solve(fr, &mut bodies.states, pass(j), &mut self.joint_blocks);
+                    // A chain's block comes after its last joint's other rows.
+                    if let Some(c) = j.chain.filter(|&c| self.chains[c].last() == i) {
+                        self.chains[c].solve(
+                            (&mut self.joints, &self.joint_frames),
+                            &mut bodies.states,
+                            pass,
+                            (&mut self.joint_blocks, &mut self.chain_blocks[c]),
+                        );
+                    }
                 }
                 let last = totals && k + 1 == count;
                 self.solve_pass(bodies, contacts.clone(), rule, bias, last);
@@ -697,6 +717,9 @@ impl Solver {
         }
         self.joint_blocks.clear();
         self.joint_blocks.resize(blocks, None);
+        self.chains = find_chains(&mut self.joints, &solver_bodies.sims);
+        self.chain_blocks.clear();
+        self.chain_blocks.resize(self.chains.len(), None);
         self.make_joint_frames(&solver_bodies.sims);
     }
 
@@ -714,6 +737,7 @@ impl Solver {
             j.write_frame(sims, fr);
         }
         self.joint_blocks.fill(None);
+        self.chain_blocks.fill(None);
     }
 
     /// The contacts to solve, ordered so that neighbours in the list rarely share a moving
