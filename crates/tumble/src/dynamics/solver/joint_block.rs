@@ -133,13 +133,6 @@ impl HardRows {
     }
 }
 
-/// K = J M⁻¹ Jᵀ of a joint's hard rows, eliminated once per frame: Gaussian elimination
-/// with partial pivoting, its multipliers and row swaps recorded, so that each pass only
-/// replays them on its own right-hand side. The pivots depend on K alone, so the replay
-/// does bit for bit the arithmetic of eliminating K and the right-hand side together (as
-/// each pass did before: K's build and elimination were 36 % of a cart-pole's step, made
-/// twice per frame). A vanishing pivot (a direction no body can move in, such as out of a
-/// planar body's plane) leaves that unknown zero.
 /// The numbers an [`Eliminated`] works in: `Real` for a joint's block, f64 for a chain's,
 /// whose light bodies make K too ill-conditioned for f32 (see `joint_chain.rs`).
 pub(super) trait Element:
@@ -179,6 +172,13 @@ macro_rules! element {
 element!(f32);
 element!(f64);
 
+/// K = J M⁻¹ Jᵀ of a joint's hard rows, eliminated once per frame: Gaussian elimination
+/// with partial pivoting, its multipliers and row swaps recorded, so that each pass only
+/// replays them on its own right-hand side. The pivots depend on K alone, so the replay
+/// does bit for bit the arithmetic of eliminating K and the right-hand side together (as
+/// each pass did before: K's build and elimination were 36 % of a cart-pole's step, made
+/// twice per frame). A vanishing pivot (a direction no body can move in, such as out of a
+/// planar body's plane) leaves that unknown zero.
 #[derive(Clone)]
 pub(super) struct Eliminated<const N: usize = 6, T: Element = Real> {
     /// The upper triangle left by the elimination.

@@ -1,8 +1,9 @@
 //! Chains of joints through light bodies, their hard rows solved as one block.
 //!
 //! A body with several joints in an imported model (an MJCF body with slide x, slide z and
-//! hinge y, a humanoid's hip of three hinges, a URDF planar or floating joint) becomes a
-//! chain of joints through intermediate bodies of a thousandth of the body's mass
+//! hinge y, as the roots of Gymnasium's hopper, walker and cheetah; a humanoid's hip of
+//! three hinges; a URDF planar joint) becomes a chain of joints through intermediate
+//! bodies of a thousandth (MJCF) or a hundredth (URDF) of the body's mass
 //! (`tumble_scene`'s MJCF and URDF builders). Gauss–Seidel hands a load through a light
 //! body only in proportion to the mass ratio per pass, so the chain gave way under any load
 //! across its locked directions: a planar body (slides x, z, hinge y) with gravity partly
