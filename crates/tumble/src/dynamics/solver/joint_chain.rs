@@ -31,6 +31,7 @@
 
 use super::block::Eliminated;
 use super::{Frame, JointConstraint, JointPass, Row};
+use crate::dynamics::island::{find, union};
 use crate::dynamics::joint::{AngularLock, LinearLock};
 use crate::dynamics::solver::body::{BodySim, BodyState};
 use crate::dynamics::solver::mass_ratio::HEAVY_RATIO;
@@ -60,6 +61,10 @@ pub(crate) struct ChainBlock {
 /// Finds the chains among `joints` (the solver's list, their `chain` unset), marks their
 /// members, and returns them.
 pub(crate) fn find_chains(joints: &mut [JointConstraint], sims: &[BodySim]) -> Vec<Chain> {
+    // A chain has two joints at least; without, skip the per-body lists (every step).
+    if joints.len() < 2 {
+        return Vec::new();
+    }
     let n = sims.len();
     let mut count = vec![0u32; n];
     let mut blocked = vec![0u32; n];
@@ -109,17 +114,14 @@ pub(crate) fn find_chains(joints: &mut [JointConstraint], sims: &[BodySim]) -> V
     for (i, j) in joints.iter().enumerate() {
         for k in j.bodies().into_iter().flatten().filter(|&k| link(Some(k))) {
             match by_link[k] {
-                Some(other) => {
-                    let (x, y) = (root(&mut parent, other), root(&mut parent, i));
-                    parent[x.max(y)] = x.min(y);
-                }
+                Some(other) => union(&mut parent, other, i),
                 None => by_link[k] = Some(i),
             }
         }
     }
     let mut members: Vec<Vec<usize>> = vec![Vec::new(); joints.len()];
     for i in 0..joints.len() {
-        let r = root(&mut parent, i);
+        let r = find(&mut parent, i);
         members[r].push(i);
     }
     let mut chains = Vec::new();
@@ -149,14 +151,6 @@ fn hard_rows(c: &JointConstraint) -> usize {
         AngularLock::Free => 0,
     };
     linear + angular
-}
-
-fn root(parent: &mut [usize], mut i: usize) -> usize {
-    while parent[i] != i {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    i
 }
 
 /// One side of a row as the block sees it: the body (`None`: not moved by the solver),
