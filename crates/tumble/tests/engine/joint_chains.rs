@@ -7,18 +7,10 @@
 // Casts between Real and f64 are no-ops in the default build but needed in the f32 one.
 #![allow(clippy::unnecessary_cast)]
 
-use crate::common::tol;
+use crate::common::{awake, tol};
 use tumble::prelude::*;
 
 const G: Real = 9.81;
-
-fn world_with(gravity: Vec3) -> World {
-    World::new(&WorldDef {
-        gravity,
-        sleep: false,
-        ..Default::default()
-    })
-}
 
 /// A body of `mass` kg at `at`, a box of half extents `half`; colliding with nothing when
 /// `ghost` (the light bodies, as the importers make them: no geometry).
@@ -76,7 +68,7 @@ fn a_planar_chain_holds_its_plane_and_its_free_directions_fall_freely() {
     for light in [1e-2 as Real, 1e-3, 1e-4] {
         for torso_mass in [1.0 as Real, 50.0] {
             for dt in [1.0 as Real / 60.0, 1.0 / 240.0, 0.002] {
-                let mut w = world_with(Vec3::new(0.0, -G, -G));
+                let mut w = awake(Vec3::new(0.0, -G, -G));
                 let start = Vec3::new(0.0, 2.0, 0.0);
                 let half = Vec3::new(0.3, 0.1, 0.1);
                 let l1 = body(&mut w, start, light * torso_mass, Vec3::splat(0.05), true);
@@ -154,7 +146,7 @@ fn three_hinges_through_light_bodies_swing_as_one_ball_joint() {
     // same rod on a ball joint: the two must swing together (the light bodies' own
     // turning is their share of the inertia, 1/1000 of it) and the pivot hold.
     for dt in [1.0 as Real / 60.0, 1.0 / 240.0] {
-        let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+        let mut w = awake(Vec3::new(0.0, -G, 0.0));
         let pivot = Vec3::new(0.0, 3.0, 0.0);
         let tilt = Quat::from_rotation_x(0.4) * Quat::from_rotation_z(0.3);
         let rod = |w: &mut World, x: Real| {

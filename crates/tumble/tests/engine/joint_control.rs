@@ -10,14 +10,6 @@ use tumble::JointCoordinate;
 
 const G: Real = 9.8;
 
-fn world_with(gravity: Vec3) -> World {
-    World::new(&WorldDef {
-        gravity,
-        sleep: false,
-        ..Default::default()
-    })
-}
-
 fn free_hinge() -> JointKind {
     JointKind::Hinge {
         limits: None,
@@ -76,7 +68,7 @@ fn a_door_motor_reversed_mid_run_turns_it_back_at_torque_over_inertia() {
         (1.0 as Real, 0.5 as Real, 1.0 / 60.0),
         (5.0, 4.0, 1.0 / 120.0),
     ] {
-        let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+        let mut w = awake(Vec3::new(0.0, -G, 0.0));
         let (width, height, thick) = (1.0, 2.0, 0.05);
         let door = slab(
             &mut w,
@@ -145,7 +137,7 @@ fn a_servo_holds_a_pendulum_arm_at_its_target_against_gravity() {
     // damped (c = 2√(kI)), it has settled after 3 s: the last 1/6 s moves it < 1e-6 rad.
     for target in [0.3 as Real, 1.2] {
         for mass in [1.0 as Real, 4.0] {
-            let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+            let mut w = awake(Vec3::new(0.0, -G, 0.0));
             let arm = slab(
                 &mut w,
                 Vec3::new(0.5, 0.0, 0.0),
@@ -195,7 +187,7 @@ fn a_servo_holds_a_pendulum_arm_at_its_target_against_gravity() {
 fn a_servo_with_too_little_force_cannot_hold() {
     // Capped below gravity's torque at the target (m g l/2 cos 0.3 = 4.68 N·m), the arm
     // sinks under the target instead.
-    let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+    let mut w = awake(Vec3::new(0.0, -G, 0.0));
     let arm = slab(
         &mut w,
         Vec3::new(0.5, 0.0, 0.0),
@@ -223,7 +215,7 @@ fn joint_position_follows_the_small_angle_pendulum() {
     // of θ₀ bounds both with room, and a wrong sign or zero would miss by 100 %.
     for (length, dt) in [(1.0 as Real, 1.0 / 240.0), (0.5, 1.0 / 480.0)] {
         let theta0: Real = 0.05;
-        let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+        let mut w = awake(Vec3::new(0.0, -G, 0.0));
         let p = Vec3::new(length * theta0.sin(), -length * theta0.cos(), 0.0);
         let bob = ball(&mut w, p);
         let mut def = JointDef::new(free_hinge(), bob);
@@ -304,7 +296,7 @@ fn setting_a_hinge_position_moves_the_outer_links_rigidly() {
     // unit-size poses); 1e-5 in f32.
     let eps = tol(1e-9, 1e-5);
     for q in [0.7 as Real, -2.0] {
-        let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+        let mut w = awake(Vec3::new(0.0, -G, 0.0));
         let (links, joints) = three_links(&mut w, free_hinge());
         run(&mut w, 1.0 / 60.0, 60);
         let before = relative(&w, links[1], links[2]);
@@ -341,7 +333,7 @@ fn setting_a_hinge_position_moves_the_outer_links_rigidly() {
         assert!((gap(&w, links[0], links[1]) - gap_before).abs() < eps);
     }
     // Joint 2's own side moves (link 2 alone).
-    let mut w = world_with(Vec3::ZERO);
+    let mut w = awake(Vec3::ZERO);
     let (links, joints) = three_links(&mut w, free_hinge());
     let link1 = w.body(links[1]).unwrap().position();
     w.set_joint_position(joints[2], JointCoordinate::Scalar(1.0))
@@ -363,7 +355,7 @@ fn setting_a_hinge_position_moves_the_outer_links_rigidly() {
 fn ball_and_slider_positions_read_and_set() {
     let eps = tol(1e-9, 1e-5);
     // A ball joint: the rotation vector, in the world's frame here, set and read back.
-    let mut w = world_with(Vec3::ZERO);
+    let mut w = awake(Vec3::ZERO);
     let link = slab(
         &mut w,
         Vec3::new(0.5, 0.0, 0.0),
@@ -398,7 +390,7 @@ fn ball_and_slider_positions_read_and_set() {
     assert!((v - Vec3::new(2.0, 0.0, 0.0)).length() < eps);
 
     // A slider along x: the offset of body from the world anchor, and its rate.
-    let mut w = world_with(Vec3::ZERO);
+    let mut w = awake(Vec3::ZERO);
     let block = slab(&mut w, Vec3::new(1.0, 0.0, 0.0), Vec3::splat(0.2), 2.0);
     let mut def = JointDef::new(
         JointKind::Slider {
@@ -428,7 +420,7 @@ fn limits_changed_at_run_time_stop_the_motion_at_the_new_limit() {
     // swings down past −1.5. The limit row is rigid while approaching (speculative) and
     // soft once passed: 0.01 rad is the bound the creation-time limit test uses.
     for mass in [1.0 as Real, 3.0] {
-        let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+        let mut w = awake(Vec3::new(0.0, -G, 0.0));
         let arm = slab(
             &mut w,
             Vec3::new(0.5, 0.0, 0.0),
@@ -473,7 +465,7 @@ fn a_disabled_joint_lets_its_body_fall_freely_and_enabled_again_holds() {
     // step (the free integrator adds g·dt; only rounding differs, 1e-9 of 9.8 m/s² in
     // f64) and its spin stays as it was (a torque-free rotation about a principal axis).
     for dt in [1.0 as Real / 60.0, 1.0 / 240.0] {
-        let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+        let mut w = awake(Vec3::new(0.0, -G, 0.0));
         let arm = slab(
             &mut w,
             Vec3::new(0.5, 0.0, 0.0),
@@ -512,7 +504,7 @@ fn a_disabled_joint_lets_its_body_fall_freely_and_enabled_again_holds() {
 fn a_disabled_joint_lets_its_bodies_collide() {
     // Two boxes welded overlapping (collide_connected off): while the weld holds they do
     // not collide; disabled, the overlap is pushed apart.
-    let mut w = world_with(Vec3::ZERO);
+    let mut w = awake(Vec3::ZERO);
     let a = slab(&mut w, Vec3::ZERO, Vec3::splat(1.0), 1.0);
     let b = slab(&mut w, Vec3::new(0.5, 0.0, 0.0), Vec3::splat(1.0), 1.0);
     let mut def = JointDef::new(JointKind::Fixed, a);
@@ -531,7 +523,7 @@ fn a_disabled_joint_lets_its_bodies_collide() {
 fn a_break_force_set_at_run_time_breaks_the_joint() {
     // A 2 kg arm hangs at rest (reaction m g = 19.6 N); a break force of 10 N breaks it
     // on the next step, and a break force of 100 N would not have.
-    let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+    let mut w = awake(Vec3::new(0.0, -G, 0.0));
     let arm = slab(
         &mut w,
         Vec3::new(0.0, -0.5, 0.0),
@@ -580,7 +572,7 @@ fn setters_wake_the_bodies() {
 
 #[test]
 fn bad_values_are_refused_by_field_and_change_nothing() {
-    let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+    let mut w = awake(Vec3::new(0.0, -G, 0.0));
     let arm = slab(
         &mut w,
         Vec3::new(0.5, 0.0, 0.0),
@@ -722,7 +714,7 @@ fn limits_reaching_past_half_a_turn_hold_on_the_far_side() {
         ([-5.5, -1.0], -1.5, 2.0, 1.0 / 240.0),
     ];
     for (limits, speed, mass, dt) in cases {
-        let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+        let mut w = awake(Vec3::new(0.0, -G, 0.0));
         let door = slab(
             &mut w,
             Vec3::new(0.5, 1.0, 0.0),
@@ -778,7 +770,7 @@ fn a_servo_target_across_half_a_turn_is_reached_the_short_way() {
     // A servo at −3.0 rad sent to +3.0 rad: the short way is 0.28 rad down through −π,
     // not 6 rad back up through zero. Gravity along the hinge, so only the servo acts.
     for (mass, dt) in [(1.0 as Real, 1.0 / 60.0), (4.0, 1.0 / 120.0)] {
-        let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+        let mut w = awake(Vec3::new(0.0, -G, 0.0));
         let door = slab(
             &mut w,
             Vec3::new(0.5, 1.0, 0.0),

@@ -9,14 +9,6 @@ use tumble::prelude::*;
 
 const G: Real = 9.8;
 
-fn world_with(gravity: Vec3) -> World {
-    World::new(&WorldDef {
-        gravity,
-        sleep: false,
-        ..Default::default()
-    })
-}
-
 /// Complete elliptic integral of the first kind K(k), by the arithmetic–geometric mean.
 fn elliptic_k(k: f64) -> f64 {
     let (mut a, mut b) = (1.0f64, (1.0 - k * k).sqrt());
@@ -32,7 +24,7 @@ fn elliptic_k(k: f64) -> f64 {
 /// from the downward vertical. Returns the world, the ball, its mass, and the moment of
 /// inertia about the pivot.
 fn hinge_pendulum(length: Real, angle: Real) -> (World, BodyId, Real, Real) {
-    let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+    let mut w = awake(Vec3::new(0.0, -G, 0.0));
     let p = Vec3::new(length * angle.sin(), -length * angle.cos(), 0.0);
     let r = 0.1;
     let ball = w
@@ -174,7 +166,7 @@ fn a_chain_of_twenty_links_holds_a_ball_a_hundred_times_heavier() {
 
 /// The largest joint gap over 10 s of the chain of twenty links holding a ball of `mass`.
 fn hanging_chain_gap(mass: Real, substeps: u32, dt: Real) -> Real {
-    let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+    let mut w = awake(Vec3::new(0.0, -G, 0.0));
     let mut settings = w.solver_settings();
     settings.substeps = substeps;
     w.set_solver_settings(settings).unwrap();
@@ -268,7 +260,7 @@ fn max_joint_gap(w: &World) -> Real {
 fn a_double_pendulum_keeps_its_energy() {
     // Two 1 kg rods, hinged end to end, released horizontal: chaotic, so only the energy
     // can be checked; within 2 % of the drop of the rods' centres over 10 s at 240 Hz.
-    let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+    let mut w = awake(Vec3::new(0.0, -G, 0.0));
     let first = unit_box(&mut w, Vec3::new(0.5, 0.0, 0.0), 1.0);
     let second = unit_box(&mut w, Vec3::new(1.5, 0.0, 0.0), 1.0);
     let mut def = JointDef::new(hinge(None, None), first);
@@ -302,7 +294,7 @@ fn a_double_pendulum_keeps_its_energy() {
 
 /// A 1 kg rod hinged at one end to the world about z, starting horizontal along x.
 fn hinged_rod(kind: JointKind, gravity: Vec3) -> (World, BodyId) {
-    let mut w = world_with(gravity);
+    let mut w = awake(gravity);
     let rod = unit_box(&mut w, Vec3::new(0.5, 0.0, 0.0), 1.0);
     let mut def = JointDef::new(kind, rod);
     def.anchor = Vec3::new(-0.5, 0.0, 0.0);
@@ -387,7 +379,7 @@ fn a_hinge_motor_reaches_its_speed_or_stalls() {
 fn a_slider_keeps_its_body_on_the_axis_and_a_weld_holds() {
     // A box on a slider along a tilted axis, pulled by gravity: it must slide along the
     // axis with g·(axis·ĝ) and leave it by less than a millimetre, without turning.
-    let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+    let mut w = awake(Vec3::new(0.0, -G, 0.0));
     let axis = Vec3::new(1.0, -1.0, 0.5).normalize();
     let body = unit_box(&mut w, Vec3::ZERO, 2.0);
     let mut def = JointDef::new(
@@ -417,7 +409,7 @@ fn a_slider_keeps_its_body_on_the_axis_and_a_weld_holds() {
 
     // A fixed joint: a 1 kg rod welded to a 10 kg rod hung from the world by a ball
     // joint, as a horizontal cantilever; the weld must keep their relative pose.
-    let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+    let mut w = awake(Vec3::new(0.0, -G, 0.0));
     let heavy = unit_box(&mut w, Vec3::ZERO, 10.0);
     let light = unit_box(&mut w, Vec3::new(1.0, 0.0, 0.0), 1.0);
     let mut hang = JointDef::new(JointKind::Fixed, heavy);
@@ -442,7 +434,7 @@ fn a_slider_keeps_its_body_on_the_axis_and_a_weld_holds() {
 fn a_joint_breaks_past_its_break_force_and_joined_bodies_do_not_collide() {
     // A 1 kg ball hangs from a joint that breaks beyond 20 N: it holds the 9.8 N weight,
     // and breaks when a 30 N pull is added.
-    let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+    let mut w = awake(Vec3::new(0.0, -G, 0.0));
     let b = ball(&mut w, Vec3::new(0.0, -1.0, 0.0));
     let mut def = JointDef::new(
         JointKind::Ball {
@@ -479,7 +471,7 @@ fn a_joint_breaks_past_its_break_force_and_joined_bodies_do_not_collide() {
     // Two overlapping boxes joined by a ball joint stay overlapped (no contact pushes
     // them apart) unless the joint asks for collisions.
     for collide in [false, true] {
-        let mut w = world_with(Vec3::ZERO);
+        let mut w = awake(Vec3::ZERO);
         let a = unit_box(&mut w, Vec3::ZERO, 1.0);
         let c = unit_box(&mut w, Vec3::new(0.5, 0.0, 0.0), 1.0);
         let mut def = JointDef::new(
@@ -506,7 +498,7 @@ fn a_joint_breaks_past_its_break_force_and_joined_bodies_do_not_collide() {
 
 #[test]
 fn bad_joint_definitions_name_the_field() {
-    let mut w = world_with(Vec3::ZERO);
+    let mut w = awake(Vec3::ZERO);
     let b = ball(&mut w, Vec3::ZERO);
     let message = |w: &mut World, def: JointDef| w.create_joint(&def).unwrap_err().to_string();
     let mut def = JointDef::new(hinge(Some([1.0, -1.0]), None), b);
@@ -545,7 +537,7 @@ fn ball_joint_cone_and_twist_limits_hold() {
     // A rod hangs from the world by a ball joint with its axis along the rod (down). A
     // sideways push swings it against a 0.5 rad cone; a torque about the rod twists it
     // against [−0.3, 0.3] rad. Neither limit may be passed by more than 0.01 rad.
-    let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+    let mut w = awake(Vec3::new(0.0, -G, 0.0));
     let rod = w
         .create_body(
             &BodyDef {
@@ -605,7 +597,7 @@ fn ball_joint_cone_and_twist_limits_hold() {
 fn slider_limits_springs_and_distance_ropes_behave() {
     // A slider along x with a spring (2 Hz, undamped) towards 0 and limits [−0.2, 0.2]:
     // released at 0.1 m with no gravity, it oscillates at 2 Hz within the limits.
-    let mut w = world_with(Vec3::ZERO);
+    let mut w = awake(Vec3::ZERO);
     let body = unit_box(&mut w, Vec3::new(0.1, 0.0, 0.0), 1.0);
     let mut def = JointDef::new(
         JointKind::Slider {
@@ -642,7 +634,7 @@ fn slider_limits_springs_and_distance_ropes_behave() {
 
     // A 1 kg ball on a 1 m rope (max only) dropped from 0.5 m beside the anchor: it
     // falls freely until the rope tightens, then hangs at 1 m.
-    let mut w = world_with(Vec3::new(0.0, -G, 0.0));
+    let mut w = awake(Vec3::new(0.0, -G, 0.0));
     let b = ball(&mut w, Vec3::new(0.5, 0.0, 0.0));
     let mut def = JointDef::new(
         JointKind::Distance {
@@ -708,7 +700,7 @@ fn a_pendulum_bouncing_off_a_wall_never_gains_energy() {
 fn joint_handles_are_generational_and_removal_reports_stale_ones() {
     // A removed joint's handle stays dead even after a new joint takes its slot, and
     // removing it again is an error, as for bodies.
-    let mut w = world_with(Vec3::ZERO);
+    let mut w = awake(Vec3::ZERO);
     let ball = w
         .create_body(&BodyDef::default(), Shape::sphere(0.1))
         .unwrap();
@@ -811,7 +803,7 @@ fn a_chassis_carrying_heavier_joined_partners_never_gains_energy() {
     for kind in [hinge, JointKind::Fixed, slider] {
         for (n, moment, mass) in cases {
             for dt in [1.0 / 60.0, 0.01, 1.0 / 240.0] {
-                let mut w = world_with(Vec3::ZERO);
+                let mut w = awake(Vec3::ZERO);
                 let chassis = w
                     .create_body(
                         &BodyDef {

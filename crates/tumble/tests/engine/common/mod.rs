@@ -26,14 +26,19 @@ pub fn world(gravity: Vec3, integrator: Integrator) -> World {
     })
 }
 
-/// A world with the given gravity, sleeping off, on a static ground plane y = 0 (default
-/// material).
-pub fn awake_on_ground(gravity: Vec3) -> World {
-    let mut w = World::new(&WorldDef {
+/// A world with the given gravity and sleeping off.
+pub fn awake(gravity: Vec3) -> World {
+    World::new(&WorldDef {
         gravity,
         sleep: false,
         ..Default::default()
-    });
+    })
+}
+
+/// A world with the given gravity, sleeping off, on a static ground plane y = 0 (default
+/// material).
+pub fn awake_on_ground(gravity: Vec3) -> World {
+    let mut w = awake(gravity);
     let ground = BodyDef {
         kind: BodyKind::Static,
         ..Default::default()
