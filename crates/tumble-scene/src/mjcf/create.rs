@@ -66,7 +66,7 @@ fn create_all(plan: &Plan, world: &mut World, made: &mut Made, prefix: &str) -> 
     };
     let mut bodies = Vec::with_capacity(plan.bodies.len());
     for (i, b) in plan.bodies.iter().enumerate() {
-        let id = create_body(plan, b, filters[i], prefix, world, made)?;
+        let id = create_body(plan, (i, b), filters[i], prefix, world, made)?;
         bodies.push(id);
     }
     let mut joints = Vec::new();
@@ -105,27 +105,40 @@ fn ordered(a: BodyId, b: BodyId) -> (BodyId, BodyId) {
 /// The body's mass properties: its parts', or for an intermediate body a thousandth of
 /// the body it carries, but never below the engine's least mass and moment (a marker
 /// body of 4e-10 kg, as Gymnasium's pusher goal, would otherwise give 4e-13 kg, which
-/// the engine refuses though the body it carries is taken).
-fn mass_of(plan: &Plan, b: &PlanBody) -> MassProperties {
+/// the engine refuses though the body it carries is taken). A body carried by
+/// intermediate bodies gives up their mass, so that the model weighs what the file
+/// says: added on top, they made a humanoid 0.07 % and a planar cheetah 0.09 % heavier
+/// than MuJoCo's, and the chain's first slide moved M + 2m where MuJoCo moves M.
+fn mass_of(plan: &Plan, index: usize) -> MassProperties {
     use tumble::limits::{MIN_MASS, MIN_MOMENT};
+    let light = |m: Real| (m * LIGHT).max(MIN_MASS);
+    let b = &plan.bodies[index];
     match b.light_of {
         Some(carried) => {
             let m = super::build::sum(plan.bodies[carried].mass.iter().copied());
             MassProperties {
-                mass: (m.mass * LIGHT).max(MIN_MASS),
+                mass: light(m.mass),
                 center: Vec3::ZERO,
                 inertia: tumble::Mat3::from_diagonal(Vec3::splat(
                     (crate::mjcf::build::largest_moment(&m) * LIGHT).max(MIN_MOMENT),
                 )),
             }
         }
-        None => super::build::sum(b.mass.iter().copied()),
+        None => {
+            let mut m = super::build::sum(b.mass.iter().copied());
+            // Not where they were raised to the least mass (a marker's).
+            if m.mass * LIGHT >= MIN_MASS {
+                let carriers = plan.bodies.iter().filter(|c| c.light_of == Some(index));
+                m.mass -= carriers.count() as Real * light(m.mass);
+            }
+            m
+        }
     }
 }
 
 fn create_body(
     plan: &Plan,
-    b: &PlanBody,
+    (index, b): (usize, &PlanBody),
     filter: (u32, u32),
     prefix: &str,
     world: &mut World,
@@ -163,7 +176,7 @@ fn create_body(
         }
         def.kind = BodyKind::Static;
     } else {
-        let m = mass_of(plan, b);
+        let m = mass_of(plan, index);
         let (moments, _) = tumble::math::symmetric_eigen(m.inertia);
         // Written so that NaN fails too.
         let positive = m.mass > 0.0 && moments.min_element() > 0.0;

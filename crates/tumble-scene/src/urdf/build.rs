@@ -261,13 +261,15 @@ fn plan_joints(
     joints
 }
 
-/// A light body's share of the body it carries: 1/1000 of its mass and largest moment.
+/// A light body's share of the body it carries: 1/100 of its mass and largest moment.
 const LIGHT: Real = 1e-2;
 
 /// URDF's planar joint (the child moves in the plane normal to the axis and turns about
 /// it): a slider along the joint frame's first in-plane direction (x for an axis along z),
 /// one along the second (n × that) and a hinge about the axis, chained through two light
-/// bodies at the child's frame that collide with nothing. The three are named
+/// bodies at the child's frame that collide with nothing. The child gives up the light
+/// bodies' mass, so that the model weighs what the file says and the first slider moves
+/// the child's mass (added on top, the light bodies made it 2 % heavier). The three are named
 /// `name/x`, `name/y` and `name/theta` (MoveIt's names for a planar joint's variables);
 /// damping and friction act on each.
 fn planar(
@@ -303,6 +305,9 @@ fn planar(
         collision_mask: 0,
         ..carried.clone()
     };
+    if let MassSpec::Mass(m) = &mut bodies[child].def.mass {
+        *m -= 2.0 * LIGHT * mass;
+    }
     let first = bodies.len();
     for _ in 0..2 {
         bodies.push(PlannedBody {
