@@ -194,8 +194,9 @@ pub(crate) struct BodySim {
     pub torsional_friction: Real,
     /// The body's multiplier of gravity (see `BodyDef::gravity_scale`).
     pub gravity_scale: Real,
-    /// The shape's `Shape::round_radius`, or `None` for a compound, whose children differ:
-    /// read here, the step's contacts need not reach into the bodies' shapes.
+    /// The shape's `Shape::round_radius`, or `None` for a compound, whose children differ,
+    /// and a cylinder, round only where it touches on its side (`Shape::round_toward`):
+    /// read here, the step's other contacts need not reach into the bodies' shapes.
     pub round: Option<Real>,
 }
 
@@ -237,7 +238,8 @@ impl BodySim {
             torsional_friction: body.torsional_friction,
             gravity_scale: body.gravity_scale,
             round: match body.shape {
-                crate::collision::shape::Shape::Compound(_) => None,
+                crate::collision::shape::Shape::Compound(_)
+                | crate::collision::shape::Shape::Cylinder { .. } => None,
                 ref shape => Some(shape.round_radius(0)),
             },
         };

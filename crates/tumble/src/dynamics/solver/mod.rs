@@ -975,10 +975,14 @@ impl PrepareWith<'_> {
             angular: angular::combine(sa, sb),
             poses: (pose(sa), pose(sb)),
             round: (
-                sa.round
-                    .unwrap_or_else(|| world_bodies[a].shape.round_radius(c.manifold.subshape_a)),
-                sb.round
-                    .unwrap_or_else(|| world_bodies[b].shape.round_radius(c.manifold.subshape_b)),
+                sa.round.unwrap_or_else(|| {
+                    let shape = &world_bodies[a].shape;
+                    shape.round_toward(c.manifold.subshape_a, sa.q, c.manifold.normal)
+                }),
+                sb.round.unwrap_or_else(|| {
+                    let shape = &world_bodies[b].shape;
+                    shape.round_toward(c.manifold.subshape_b, sb.q, c.manifold.normal)
+                }),
             ),
             slop: self.slop,
             gravity: (!(sa.moves && sb.moves) || gravity == Vec3::ZERO)
