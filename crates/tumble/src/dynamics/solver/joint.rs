@@ -47,7 +47,7 @@ use crate::math::{Mat3, Quat, Real, Vec3};
 pub(crate) use block::Block;
 use block::{apply_point, point_impulse, point_inverse_mass, solve_hard, solve_point};
 pub(crate) use chain::{find_chains, Chain, ChainBlock};
-use one_d::{free_impulse, solve_free, solve_limit, FreeDrive};
+use one_d::{free_impulse, solve_free, solve_limit, FreeDrive, Line};
 
 /// A body as a joint sees it: pose, inverse masses, whether it moves. The world is one
 /// that never moves, at the origin.
@@ -367,7 +367,8 @@ impl JointConstraint {
         });
     }
 
-    /// One pass over the joint's rows.
+    /// One pass over the joint's rows; a chain's member leaves its free row and hard rows
+    /// to its chain (`joint_chain.rs`).
     pub fn solve(
         &mut self,
         fr: &Frame,
@@ -386,11 +387,10 @@ impl JointConstraint {
         }
         let mut imp = self.impulses;
         let drive = self.drive;
-        let free = self.free_row(fr);
         let cone = self.cone_row(fr);
-        let hard = match self.chain {
-            Some(_) => None,
-            None => self.block(fr, blocks),
+        let (free, hard) = match self.chain {
+            Some(_) => (None, None),
+            None => (self.free_row(fr), self.block(fr, blocks)),
         };
         let point_mass = self.point_apart().then(|| {
             *self
@@ -399,10 +399,19 @@ impl JointConstraint {
         });
         self.with_states(states, |a, b| {
             if let Some((row, coordinate)) = free {
-                solve_free(&drive, row, coordinate, fr, pass, &mut imp, a, b);
+                solve_free(
+                    &drive,
+                    Line::own(row, fr),
+                    coordinate,
+                    fr,
+                    pass,
+                    &mut imp,
+                    a,
+                    b,
+                );
             }
             if let Some((row, c)) = cone {
-                imp.cone = solve_limit(row, c, imp.cone, fr, pass, a, b);
+                imp.cone = solve_limit(Line::own(row, fr), c, imp.cone, fr, pass, a, b);
             }
             if let Some(block) = hard {
                 imp.hard = solve_hard(block, imp.hard, fr, pass, a, b);
@@ -413,6 +422,24 @@ impl JointConstraint {
             }
         });
         self.impulses = imp;
+    }
+
+    /// One pass over `part` of the free row's drive (one of `FreeDrive::parts`), the row
+    /// as its chain sees it, at `coordinate`; returns the impulse it added along the row.
+    fn solve_free_part(
+        &mut self,
+        part: &FreeDrive,
+        (line, coordinate): (Line, Real),
+        (fr, pass): (&Frame, &JointPass),
+        states: &mut [BodyState],
+    ) -> Real {
+        let mut imp = self.impulses;
+        self.with_states(states, |a, b| {
+            solve_free(part, line, coordinate, fr, pass, &mut imp, a, b);
+        });
+        let delta = free_impulse(&imp) - free_impulse(&self.impulses);
+        self.impulses = imp;
+        delta
     }
 
     /// Adds the substep's impulses to the step's totals: the force on `other` at its

@@ -22,8 +22,9 @@ use crate::math::Real;
 
 /// A one-sided limit row: keeps `margin` ≥ 0 (speculatively while it is positive, as a
 /// contact does). Returns the new accumulated impulse (≥ 0).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn solve_limit(
-    row: Row,
+    line: Line,
     margin: Real,
     acc: Real,
     fr: &Frame,
@@ -31,6 +32,7 @@ pub(super) fn solve_limit(
     a: &mut BodyState,
     b: &mut BodyState,
 ) -> Real {
+    let Line { row, mass, .. } = line;
     let (bias, mass_scale, impulse_scale) = if margin > 0.0 {
         (margin * pass.inv_h, 1.0, 0.0)
     } else if pass.bias {
@@ -42,12 +44,51 @@ pub(super) fn solve_limit(
     } else {
         (0.0, 1.0, 0.0)
     };
-    let delta =
-        -row.mass(&fr.sa, &fr.sb) * mass_scale * (row.velocity(a, b) + bias) - impulse_scale * acc;
+    let delta = -mass * mass_scale * (line.velocity(a, b) + bias) - impulse_scale * acc;
     let total = (acc + delta).max(0.0);
 
     row.apply(total - acc, &fr.sa, &fr.sb, a, b);
     total
+}
+
+/// A free row as its drive solves it: the row, its effective mass, and what its velocity
+/// reads besides the bodies' (a chain's pending correction of its hard rows, see
+/// `joint_chain.rs`; zero for a joint of its own).
+#[derive(Clone, Copy)]
+pub(super) struct Line {
+    pub row: Row,
+    pub mass: Real,
+    pub offset: Real,
+}
+
+impl Line {
+    /// The row as it is for a joint of its own.
+    pub fn own(row: Row, fr: &Frame) -> Line {
+        Line {
+            row,
+            mass: row.mass(&fr.sa, &fr.sb),
+            offset: 0.0,
+        }
+    }
+
+    fn negated(self) -> Line {
+        Line {
+            row: self.row.negated(),
+            offset: -self.offset,
+            ..self
+        }
+    }
+
+    /// J v, plus the offset when there is one (a +0 added to a −0 would change recorded
+    /// results).
+    fn velocity(&self, a: &BodyState, b: &BodyState) -> Real {
+        let v = self.row.velocity(a, b);
+        if self.offset != 0.0 {
+            v + self.offset
+        } else {
+            v
+        }
+    }
 }
 
 /// The impulse along the free coordinate's row: limits (the upper one's row is negated),
@@ -113,6 +154,49 @@ impl FreeDrive {
         crate::dynamics::joint::coords::in_window(angle, centre)
     }
 
+    /// The drive's rows one at a time, in `solve_free`'s order, each as a drive of its
+    /// own (the limits as two, one-sided), for a chain to carry each row's impulse through
+    /// its hard rows before the next row reads the velocities.
+    pub fn parts(&self) -> impl Iterator<Item = FreeDrive> {
+        let none = FreeDrive::default();
+        let side = |lower: bool| {
+            self.limits
+                .map(|[l, u]| match lower {
+                    true => [l, Real::INFINITY],
+                    false => [Real::NEG_INFINITY, u],
+                })
+                .filter(|[l, u]| l.is_finite() || u.is_finite())
+        };
+        [
+            FreeDrive {
+                spring: self.spring,
+                ..none
+            },
+            FreeDrive {
+                servo: self.servo,
+                ..none
+            },
+            FreeDrive {
+                motor: self.motor,
+                ..none
+            },
+            FreeDrive {
+                limits: side(true),
+                ..none
+            },
+            FreeDrive {
+                limits: side(false),
+                ..none
+            },
+            FreeDrive {
+                rod: self.rod,
+                ..none
+            },
+        ]
+        .into_iter()
+        .filter(|d| !d.is_idle())
+    }
+
     /// Whether nothing acts on the free coordinate.
     pub fn is_idle(&self) -> bool {
         self.limits.is_none()
@@ -127,7 +211,7 @@ impl FreeDrive {
 #[allow(clippy::too_many_arguments)]
 pub(super) fn solve_free(
     drive: &FreeDrive,
-    row: Row,
+    line: Line,
     coordinate: Real,
     fr: &Frame,
     pass: &JointPass,
@@ -136,7 +220,7 @@ pub(super) fn solve_free(
     b: &mut BodyState,
 ) {
     if let Some(s) = drive.spring {
-        imp.spring = solve_spring(row, coordinate, &s, imp.spring, fr, pass, a, b);
+        imp.spring = solve_spring(line, coordinate, &s, imp.spring, fr, pass, a, b);
     }
     // Solved in both passes, as the frequency spring is. Its row's mass is the free
     // coordinate's own (a hinge: the body's inertia about its centre, not the pivot's),
@@ -144,28 +228,29 @@ pub(super) fn solve_free(
     // static stiffness is only near k (measured: a hinged arm sagged 0.67 τ/k at k = 5000
     // N·m/rad, 0.83 τ/k at 500); solved once a substep it came out 0.36 τ/k.
     if let Some(s) = drive.servo {
-        imp.servo = solve_servo(row, coordinate, &s, imp.servo, fr, pass, a, b);
+        imp.servo = solve_servo(line, coordinate, &s, imp.servo, fr, pass, a, b);
     }
     if let Some(m) = drive.motor {
-        imp.motor = solve_motor(row, &m, imp.motor, fr, pass, a, b);
+        imp.motor = solve_motor(line, &m, imp.motor, fr, pass, a, b);
     }
     if let Some([lower, upper]) = drive.limits {
         if lower.is_finite() {
-            imp.lower = solve_limit(row, coordinate - lower, imp.lower, fr, pass, a, b);
+            imp.lower = solve_limit(line, coordinate - lower, imp.lower, fr, pass, a, b);
         }
         if upper.is_finite() {
-            imp.upper = solve_limit(row.negated(), upper - coordinate, imp.upper, fr, pass, a, b);
+            let margin = upper - coordinate;
+            imp.upper = solve_limit(line.negated(), margin, imp.upper, fr, pass, a, b);
         }
     }
     if let Some(rest) = drive.rod {
-        imp.axial = solve_rod(row, coordinate, rest, imp.axial, fr, pass, a, b);
+        imp.axial = solve_rod(line, coordinate, rest, imp.axial, fr, pass, a, b);
     }
 }
 
 /// The distance joint's rigid rod: the distance held at `rest` by the joint softness.
 #[allow(clippy::too_many_arguments)]
 fn solve_rod(
-    row: Row,
+    line: Line,
     distance: Real,
     rest: Real,
     acc: Real,
@@ -174,20 +259,21 @@ fn solve_rod(
     a: &mut BodyState,
     b: &mut BodyState,
 ) -> Real {
+    let Line { row, mass, .. } = line;
     let bias = if pass.bias {
         pass.soft.bias_rate * (distance - rest)
     } else {
         0.0
     };
-    let delta = -row.mass(&fr.sa, &fr.sb) * pass.soft.mass_scale * (row.velocity(a, b) + bias)
-        - pass.soft.impulse_scale * acc;
+    let delta =
+        -mass * pass.soft.mass_scale * (line.velocity(a, b) + bias) - pass.soft.impulse_scale * acc;
     row.apply(delta, &fr.sa, &fr.sb, a, b);
     acc + delta
 }
 
 #[allow(clippy::too_many_arguments)]
 fn solve_spring(
-    row: Row,
+    line: Line,
     coordinate: Real,
     spring: &JointSpring,
     acc: Real,
@@ -196,16 +282,16 @@ fn solve_spring(
     a: &mut BodyState,
     b: &mut BodyState,
 ) -> Real {
+    let Line { row, mass, .. } = line;
     let soft = Softness::new(spring.hertz, spring.damping_ratio, pass.h);
     let bias = soft.bias_rate * (coordinate - spring.target);
-    let delta = -row.mass(&fr.sa, &fr.sb) * soft.mass_scale * (row.velocity(a, b) + bias)
-        - soft.impulse_scale * acc;
+    let delta = -mass * soft.mass_scale * (line.velocity(a, b) + bias) - soft.impulse_scale * acc;
     row.apply(delta, &fr.sa, &fr.sb, a, b);
     acc + delta
 }
 
 fn solve_motor(
-    row: Row,
+    line: Line,
     motor: &Motor,
     acc: Real,
     fr: &Frame,
@@ -213,8 +299,9 @@ fn solve_motor(
     a: &mut BodyState,
     b: &mut BodyState,
 ) -> Real {
+    let Line { row, mass, .. } = line;
     let limit = motor.max_force * pass.h;
-    let delta = -row.mass(&fr.sa, &fr.sb) * (row.velocity(a, b) - motor.speed);
+    let delta = -mass * (line.velocity(a, b) - motor.speed);
     let total = (acc + delta).clamp(-limit, limit);
     row.apply(total - acc, &fr.sa, &fr.sb, a, b);
     total
@@ -228,7 +315,7 @@ fn solve_motor(
 /// impulse enters scaled by 1/(1 + s K). Stable for any k, c ≥ 0.
 #[allow(clippy::too_many_arguments)]
 fn solve_servo(
-    row: Row,
+    line: Line,
     coordinate: Real,
     servo: &Servo,
     acc: Real,
@@ -237,14 +324,14 @@ fn solve_servo(
     a: &mut BodyState,
     b: &mut BodyState,
 ) -> Real {
-    let mass = row.mass(&fr.sa, &fr.sb);
+    let Line { row, mass, .. } = line;
     let s = pass.h * (servo.damping + pass.h * servo.stiffness);
     if mass <= 0.0 || s <= 0.0 {
         return acc;
     }
     let k_inv = 1.0 / mass;
     let bias = servo.stiffness / (servo.damping + pass.h * servo.stiffness);
-    let delta = -(row.velocity(a, b) + bias * (coordinate - servo.target)) / (k_inv + 1.0 / s)
+    let delta = -(line.velocity(a, b) + bias * (coordinate - servo.target)) / (k_inv + 1.0 / s)
         - acc / (1.0 + s * k_inv);
     let limit = servo.max_force * pass.h;
     let total = (acc + delta).clamp(-limit, limit);

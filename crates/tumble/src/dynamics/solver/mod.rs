@@ -341,6 +341,15 @@ impl Solver {
                     }
                 };
                 for i in joints.clone() {
+                    if let Some(c) = self.joints[i].chain {
+                        self.chains[c].solve_free(
+                            i,
+                            (&mut self.joints, &self.joint_frames),
+                            &mut bodies.states,
+                            pass,
+                            (&mut self.joint_blocks, &mut self.chain_blocks[c]),
+                        );
+                    }
                     let (j, fr) = (&mut self.joints[i], &self.joint_frames[i]);
                     j.solve(fr, &mut bodies.states, pass(j), &mut self.joint_blocks);
                     // A chain's block comes after its last joint's other rows.
