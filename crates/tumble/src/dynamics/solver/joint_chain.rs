@@ -25,8 +25,8 @@
 //! - each part's impulse δ carried on at once through the hard rows (−K⁻¹ K_hf δ), which
 //!   leaves their velocities as they were; left on the light body, the next part of the
 //!   same joint met it spun 2000 times too fast: NaN in the dog's first step;
-//! - reading its velocity as it will be once the block has acted, J_f v − (K⁻¹ K_hf)ᵀ(J_h v
-//!   + bias): read off the light body, a hard row's error turned into an impulse sized by
+//! - reading its velocity as it will be once the block has acted, J_f v − yᵀ(J_h v +
+//!   bias) with y = K⁻¹ K_hf: read off the light body, a hard row's error turned into an impulse sized by
 //!   the heavy mass, and humanoid_CMU's neck rang up to NaN within 5 steps;
 //! - the block's soft leak (impulse_scale·λ) skipping the carried part: leaked, it moved
 //!   the light bodies 2000 times what the free rows meant, rung up twentyfold a pass.
