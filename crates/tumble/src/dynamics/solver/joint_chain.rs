@@ -87,6 +87,28 @@ struct Free {
     /// K⁻¹ K_hf: per hard row, the impulse the block answers a unit impulse on the free
     /// row with (negated), so that the hard rows' velocities stay as they were.
     carry: [f64; CHAIN_ROWS],
+    /// What those impulses do to the chain's bodies, per unit impulse on the free row:
+    /// each moving body's (Δv, Δω), summed over the hard rows once per frame. Applied
+    /// row by row instead, the carry was a sixth of humanoid_CMU's step.
+    turns: Vec<(usize, Vec3, Vec3)>,
+}
+
+/// Per moving body of the chain, the velocity change of impulses −`carry` on the hard rows
+/// `reach` (see [`Free::turns`]).
+fn turns(reach: &[[Reach; 2]], carry: &[f64; CHAIN_ROWS]) -> Vec<(usize, Vec3, Vec3)> {
+    let mut out: Vec<(usize, Vec3, Vec3)> = Vec::new();
+    for (sides, &y) in reach.iter().zip(carry) {
+        let impulse = -y as Real;
+        for x in sides {
+            let Some(k) = x.body else { continue };
+            let (dv, dw) = (x.m_inv_j.0 * impulse, x.m_inv_j.1 * impulse);
+            match out.iter_mut().find(|(b, _, _)| *b == k) {
+                Some((_, v, w)) => (*v, *w) = (*v + dv, *w + dw),
+                None => out.push((k, dv, dw)),
+            }
+        }
+    }
+    out
 }
 
 impl ChainBlock {
@@ -305,6 +327,7 @@ impl Chain {
                     joint: i,
                     mass,
                     carry: y,
+                    turns: turns(&reach, &y),
                 });
             }
         }
@@ -348,7 +371,7 @@ impl Chain {
         for part in joints[i].drive.parts() {
             let delta = joints[i].solve_free_part(&part, (line, coordinate), (fr, p), states);
             if let Some(free) = free.filter(|_| delta != 0.0) {
-                self.carry((chain, free, delta), (joints, frames), states, blocks);
+                self.carry((chain, free, delta), joints, states);
             }
         }
     }
@@ -391,21 +414,15 @@ impl Chain {
     fn carry(
         &self,
         (chain, free, delta): (&ChainBlock, &Free, Real),
-        (joints, frames): (&mut [JointConstraint], &[Frame]),
+        joints: &mut [JointConstraint],
         states: &mut [BodyState],
-        blocks: &mut [Option<super::Block>],
     ) {
+        for &(k, dv, dw) in &free.turns {
+            states[k].v += dv * delta;
+            states[k].w += dw * delta;
+        }
         for (s, &(m, row)) in chain.rows.iter().enumerate() {
-            let j = self.joints[m];
-            let fr = &frames[j];
-            let Some(block) = joints[j].block(fr, blocks) else {
-                continue;
-            };
-            let line = block.hard.rows[row];
-            let impulse = -(free.carry[s] * delta as f64) as Real;
-            let c = &mut joints[j];
-            c.with_states(states, |a, b| line.apply(impulse, &fr.sa, &fr.sb, a, b));
-            c.impulses.hard[row] += impulse;
+            joints[self.joints[m]].impulses.hard[row] -= (free.carry[s] * delta as f64) as Real;
         }
     }
 
