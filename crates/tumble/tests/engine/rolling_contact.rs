@@ -462,21 +462,22 @@ fn down_a_slope_a_ball_speeds_up_at_five_sevenths_g_sin_theta() {
     }
 }
 
-/// In f64 only: in the f32 build the 5 cm cylinder at 7.5 m/s hops once where its line
-/// of contact reaches a cell's diagonal (2.9 mm up at 0.11 m/s, then 0.18 m/s down, at x
-/// = 22.1 m), which no f64 run does; not yet understood (docs/integrators.md).
-#[cfg(not(feature = "f32"))]
 #[test]
 fn cylinders_roll_across_triangle_edges_as_measured() {
     // A cylinder lying on its side is round about its axis (`Shape::round_toward`), and
     // on a plane or a box it meets the module's bounds. Across a mesh's or a height
-    // field's edges it does not yet: where its line of contact crosses a cell's diagonal
-    // it sinks further and moves off its surface faster than a capsule does. Measured
-    // (f64, dt 1/60; a quarter of it at dt 1/240): the 5 cm cylinder 0.15 mm deep (the
-    // capsules' bound 0.1), the slender one (r 0.1 m, 0.6 m long) 0.29 mm (0.13 at rest),
-    // v_n up to 3.8e-3 m/s (r 0.35 m at 8 m/s), 2.6e-3 m/s off a slope whose closed-form
-    // acceleration it keeps to 1e-5. Before cylinders were round: 0.40 mm and 0.080 m/s
-    // on every ground, 1.3 % of the speed lost in 10 s. These bounds keep what was gained.
+    // field's edges it meets them at 0.5 m/s, not yet faster: where its line of contact
+    // crosses a cell's diagonal a clipped end takes a new feature id, 3 to 13 cm from
+    // where it was last step, and starts from no impulse. Measured (f64 and f32 alike,
+    // dt 1/60 and 1/240): at most 0.16 mm deep (the capsules' bound 0.1), v_n up to
+    // 3.9e-3 m/s (r 0.35 m at 8 m/s), 2.6e-3 m/s off a slope whose closed-form
+    // acceleration it keeps to 1e-5. Before cylinders were round: 0.40 mm and 0.080 m/s on
+    // every ground. Before their face contacts with a triangle were its clipped side line
+    // (`narrow_phase::mesh`) and their points kept their warm starts from triangle to
+    // triangle (`contact_cache::warm_start_across`), in f32 the 5 cm one hopped 2.9 mm at
+    // 7.5 m/s (0.18 m/s), the 0.35 m and 1 m ones reached 0.03 m/s at 8 m/s, and one made
+    // lying on a cell edge (8 m/s starts it at x = −36) got a single point 1.9 mm off its
+    // line, spinning away from the ground, and fell freely for its first step (1.7 mm).
     for ground in [Ground::Mesh, Ground::Field] {
         for dt in [1.0 / 60.0, 1.0 / 240.0] {
             for roller in [
@@ -487,17 +488,20 @@ fn cylinders_roll_across_triangle_edges_as_measured() {
                 Roller::Cylinder { r: 0.35, half: 0.1 },
                 Roller::Cylinder { r: 0.1, half: 0.3 },
             ] {
-                // 7.5 m/s starts it at x = −33.75, off the cells' edges: made lying exactly
-                // on one (x = −36 for 8 m/s), the 5 cm cylinder's first contact came as a
-                // single point in the f32 build and it fell freely for a step (1.7 mm), a
-                // defect of the cylinder–triangle contact rather than of rolling.
-                for v0 in [0.5, 7.5] {
+                for v0 in [0.5, 7.5, 8.0] {
                     let m = roll(ground, roller, (v0, dt), Order::GroundFirst);
                     let at = format!("{ground:?}, {roller:?} at {v0} m/s, dt {dt:.4}: {m:?}");
-                    assert!(m.height < 4e-4, "sank: {at}");
+                    // The slender one rests 0.13 mm deep, two points each under about a third
+                    // of its weight (as the slender capsules do).
+                    let slender = matches!(roller, Roller::Cylinder { half: 0.3, .. });
+                    let depth = if slender { 3e-4 } else { 2e-4 };
+                    assert!(m.height < depth, "sank: {at}");
                     assert!(m.normal_speed < 5e-3, "normal velocity: {at}");
-                    assert!(m.speed < 5e-3, "speed not kept: {at}");
-                    assert!(m.travel < 5e-3, "travel unlike ∫v dt: {at}");
+                    assert!(m.speed < 1e-3, "speed not kept: {at}");
+                    assert!(m.travel < 1e-4, "travel unlike ∫v dt: {at}");
+                    if v0 == 0.5 && !slender {
+                        assert!(m.height < 1e-4 && m.normal_speed < 1e-3, "slowly: {at}");
+                    }
                 }
             }
         }
@@ -508,7 +512,7 @@ fn cylinders_roll_across_triangle_edges_as_measured() {
             1.0 / 60.0,
         );
         assert!(
-            (a - closed).abs() < 5e-3 * closed,
+            (a - closed).abs() < 1e-4 * closed,
             "{ground:?}: a = {a}, closed form {closed}"
         );
         assert!(off < 5e-3, "{ground:?}: {off} m/s off the slope");
