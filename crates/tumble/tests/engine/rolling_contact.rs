@@ -469,9 +469,10 @@ fn cylinders_roll_across_triangle_edges_as_measured() {
     // field's edges it meets them at 0.5 m/s, not yet faster: where its line of contact
     // crosses a cell's diagonal a clipped end takes a new feature id, 3 to 13 cm from
     // where it was last step, and starts from no impulse. Measured (f64 and f32 alike,
-    // dt 1/60 and 1/240): at most 0.16 mm deep (the capsules' bound 0.1), v_n up to
-    // 3.9e-3 m/s (r 0.35 m at 8 m/s), 2.6e-3 m/s off a slope whose closed-form
-    // acceleration it keeps to 1e-5. Before cylinders were round: 0.40 mm and 0.080 m/s on
+    // dt 1/60 and 1/240): at most 0.16 mm deep (the capsules' bound 0.1), the slender one
+    // (r 0.1 m, 0.6 m long) 0.23 mm (0.13 at rest), v_n up to 3.9e-3 m/s (r 0.35 m at
+    // 8 m/s), 2.6e-3 m/s off a slope whose closed-form acceleration it keeps to 1.5e-5.
+    // Before cylinders were round: 0.40 mm and 0.080 m/s on
     // every ground. Before their face contacts with a triangle were its clipped side line
     // (`narrow_phase::mesh`) and their points kept their warm starts from triangle to
     // triangle (`contact_cache::warm_start_across`), in f32 the 5 cm one hopped 2.9 mm at
