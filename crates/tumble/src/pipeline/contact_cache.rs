@@ -435,7 +435,7 @@ fn push_new(
     let first = contacts.len();
     // The first manifolds' unmatched points (a body resting across a mesh's triangles
     // touches a few); the rest keep `warm_start`'s matches alone.
-    let mut unmatched = [0u32; 16];
+    let (mut unmatched, mut used) = ([0u32; 16], [0u32; 16]);
     let mut any = false;
     for manifold in manifolds {
         contacts.push(Contact {
@@ -452,14 +452,14 @@ fn push_new(
         let k = contacts.len() - 1 - first;
         let contact = contacts.last_mut().expect("just pushed");
         let before = old.find(contact.key());
-        let missed = warm_start(contact, before, (pa, pb));
-        if let Some(m) = unmatched.get_mut(k) {
-            *m = missed;
+        let (missed, matched) = warm_start(contact, before, (pa, pb));
+        if let (Some(m), Some(u)) = (unmatched.get_mut(k), used.get_mut(k)) {
+            (*m, *u) = (missed, matched);
             any |= missed != 0;
         }
     }
     if any {
-        warm_start_across(&mut contacts[first..], &unmatched, old);
+        warm_start_across(&mut contacts[first..], (&unmatched, &used), old);
     }
 }
 
@@ -471,7 +471,11 @@ fn push_new(
 /// triangle to the next keeps its impulses and friction anchors; started from zero, the
 /// soft contact gave way for a step at each crossing (a 0.35 m cylinder rolling over a
 /// height field's cell edges sank and rose at 2.7 mm/s each time, at dt 1/60 s).
-fn warm_start_across(contacts: &mut [Contact], unmatched: &[u32], old: &Sorted<'_>) {
+fn warm_start_across(
+    contacts: &mut [Contact],
+    (unmatched, used): (&[u32], &[u32]),
+    old: &Sorted<'_>,
+) {
     let Some(c0) = contacts.first() else {
         return;
     };
@@ -502,7 +506,16 @@ fn warm_start_across(contacts: &mut [Contact], unmatched: &[u32], old: &Sorted<'
         }
     }
     near.sort_by(|x, y| x.0.total_cmp(&y.0));
-    let (mut given, mut taken) = (Vec::new(), Vec::new());
+    // The old points `warm_start` gave to their own key's new points are taken already:
+    // handed on again, one old impulse would push twice.
+    let mut taken = Vec::new();
+    for (c, &bits) in contacts.iter().zip(used).filter(|(_, &b)| b != 0) {
+        if let Some(k) = olds.iter().position(|o| o.key() == c.key()) {
+            let points = 0..olds[k].manifold.len();
+            taken.extend(points.filter(|l| bits & (1 << l) != 0).map(|l| (k, l)));
+        }
+    }
+    let mut given = Vec::new();
     for (_, i, j, k, l) in near {
         // Impulses are per substep of the length their contact was solved at (`fine`,
         // see `solver/stacks.rs`): a contact takes them from contacts solved as it was, or,
@@ -961,8 +974,12 @@ fn keep_previous(
 /// whose features were renamed (a pair routine may pick the other box's face as reference
 /// from one step to the next), by proximity — the old point within `MATCH_DISTANCE` of it.
 /// Losing warm starts on a resting stack would restart its solution from zero each time.
-/// Returns the points matched to none (bit j for point j).
-fn warm_start(contact: &mut Contact, previous: Option<&Contact>, poses: (&Pose, &Pose)) -> u32 {
+/// Returns the new points matched to none and the old points matched (bit j for point j).
+fn warm_start(
+    contact: &mut Contact,
+    previous: Option<&Contact>,
+    poses: (&Pose, &Pose),
+) -> (u32, u32) {
     let anchor_here = |p: &mut crate::collision::narrow_phase::ContactPoint| {
         let mid = (p.point_a + p.point_b) * 0.5;
         p.anchor_a = poses.0.inverse_transform_point(mid);
@@ -975,7 +992,7 @@ fn warm_start(contact: &mut Contact, previous: Option<&Contact>, poses: (&Pose, 
             .points_mut()
             .iter_mut()
             .for_each(anchor_here);
-        return (1 << contact.manifold.len()) - 1;
+        return ((1 << contact.manifold.len()) - 1, 0);
     };
     (contact.new, contact.gate) = (false, old.gate);
     let old = &old.manifold;
@@ -983,20 +1000,20 @@ fn warm_start(contact: &mut Contact, previous: Option<&Contact>, poses: (&Pose, 
     contact.manifold.overlap = old.overlap;
     contact.manifold.fine = old.fine;
     let mid = |a: Vec3, b: Vec3| (a + b) * 0.5;
-    let mut unmatched = 0;
+    let (mut unmatched, mut used) = (0, 0);
     for (j, p) in contact.manifold.points_mut().iter_mut().enumerate() {
         let here = mid(p.point_a, p.point_b);
-        let by_feature = old.points().iter().find(|q| q.feature == p.feature);
+        let olds = old.points().iter().enumerate();
+        let by_feature = olds.clone().find(|(_, q)| q.feature == p.feature);
         let by_place = || {
-            old.points()
-                .iter()
-                .map(|q| (q, (mid(q.point_a, q.point_b) - here).length_squared()))
-                .filter(|(_, d2)| *d2 < MATCH_DISTANCE * MATCH_DISTANCE)
-                .min_by(|x, y| x.1.total_cmp(&y.1))
-                .map(|(q, _)| q)
+            olds.map(|(l, q)| (l, q, (mid(q.point_a, q.point_b) - here).length_squared()))
+                .filter(|&(_, _, d2)| d2 < MATCH_DISTANCE * MATCH_DISTANCE)
+                .min_by(|x, y| x.2.total_cmp(&y.2))
+                .map(|(l, q, _)| (l, q))
         };
         match by_feature.or_else(by_place) {
-            Some(q) => {
+            Some((l, q)) => {
+                used |= 1 << l;
                 p.normal_impulse = q.normal_impulse;
                 p.tangent_impulse = q.tangent_impulse;
                 if q.anchored && !q.sliding {
@@ -1011,7 +1028,7 @@ fn warm_start(contact: &mut Contact, previous: Option<&Contact>, poses: (&Pose, 
             }
         }
     }
-    unmatched
+    (unmatched, used)
 }
 
 // `warm_start`'s bit per point.

@@ -664,7 +664,9 @@ fn a_ball_on_a_ridge_touches_the_ridge() {
 fn a_box_slides_over_a_mesh_floor_as_over_a_plane() {
     // End to end through the world: a frictionless box sliding at 3 m/s for 4 s crosses
     // 12 cells' worth of seams and diagonals. Ghost normals would kick it up or stop it
-    // dead; without them it moves exactly as on a plane.
+    // dead; without them it moves exactly as on a plane. A corner reaching the next
+    // triangle keeps its warm start (`contact_cache::warm_start_across`): measured |v_y|
+    // up to 2.5e-4 m/s (8.7e-5 on the plane), 5.4e-4 when such points restarted from zero.
     let slide = |ground: Shape| {
         let mut w = World::new(&WorldDef::default());
         let fixed = BodyDef {
@@ -698,7 +700,7 @@ fn a_box_slides_over_a_mesh_floor_as_over_a_plane() {
     ] {
         let kind = ground.kind_name();
         let (p, max_vy, min_vx) = slide(ground);
-        assert!(max_vy < 0.01, "{kind}: bounced, |vy| up to {max_vy}");
+        assert!(max_vy < 4e-4, "{kind}: bounced, |vy| up to {max_vy}");
         assert!(min_vx > 2.99, "{kind}: slowed to {min_vx}");
         assert!((p - on_plane).length() < 1e-3, "{kind}: {p} vs {on_plane}");
     }
