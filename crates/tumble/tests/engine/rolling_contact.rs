@@ -201,6 +201,21 @@ enum Order {
 /// contact whether it rolls or rests, so normal velocities are measured after this.
 const SETTLED: Real = 0.25;
 
+/// Adds `roller` (2 kg, friction 0.8) at `position`, rolling along +x at `v0` without
+/// slipping over ground below it.
+fn add_roller(w: &mut World, roller: Roller, position: Vec3, v0: Real) -> BodyId {
+    let def = BodyDef {
+        position,
+        orientation: roller.orientation(),
+        linear_velocity: Vec3::new(v0, 0.0, 0.0),
+        angular_velocity: Vec3::new(0.0, 0.0, -v0 / roller.radius()),
+        friction: 0.8,
+        mass: MassSpec::Mass(2.0),
+        ..Default::default()
+    };
+    w.create_body(&def, roller.shape()).unwrap()
+}
+
 /// Rolls `roller` along +x at `v0`, without slipping, for `duration` on `ground`.
 fn roll(ground: Ground, roller: Roller, (v0, dt): (Real, Real), order: Order) -> Measured {
     let duration = 10.0;
@@ -211,16 +226,7 @@ fn roll(ground: Ground, roller: Roller, (v0, dt): (Real, Real), order: Order) ->
     let r = roller.radius();
     // Off the mesh's vertex lines, so that its edges pass under the body at all angles.
     let start = Vec3::new(-0.45 * v0 * duration, r, 0.3);
-    let def = BodyDef {
-        position: start,
-        orientation: roller.orientation(),
-        linear_velocity: Vec3::new(v0, 0.0, 0.0),
-        angular_velocity: Vec3::new(0.0, 0.0, -v0 / r),
-        friction: 0.8,
-        mass: MassSpec::Mass(2.0),
-        ..Default::default()
-    };
-    let id = w.create_body(&def, roller.shape()).unwrap();
+    let id = add_roller(&mut w, roller, start, v0);
     if order == Order::RollerFirst {
         add_ground(&mut w, ground, 0.0);
     }
@@ -536,16 +542,7 @@ fn a_cylinder_made_lying_along_a_cell_edge_is_held_from_its_first_step() {
                     let mut w = empty_world();
                     add_ground(&mut w, ground, 0.0);
                     let roller = Roller::Cylinder { r, half };
-                    let def = BodyDef {
-                        position: Vec3::new(x, r, 0.3),
-                        orientation: roller.orientation(),
-                        linear_velocity: Vec3::new(v0, 0.0, 0.0),
-                        angular_velocity: Vec3::new(0.0, 0.0, -v0 / r),
-                        friction: 0.8,
-                        mass: MassSpec::Mass(2.0),
-                        ..Default::default()
-                    };
-                    let id = w.create_body(&def, roller.shape()).unwrap();
+                    let id = add_roller(&mut w, roller, Vec3::new(x, r, 0.3), v0);
                     w.step(dt).unwrap();
                     let b = w.body(id).unwrap();
                     let (sink, vy) = (r - b.position().y, b.linear_velocity().y);
