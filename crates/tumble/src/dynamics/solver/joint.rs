@@ -40,7 +40,7 @@ mod one_d;
 #[path = "joint_rows.rs"]
 mod rows;
 
-use super::body::{BodySim, BodyState};
+use super::body::{BodySim, BodyState, PairAccess};
 use super::softness::Softness;
 use crate::dynamics::joint::{AngularLock, Joint, JointImpulses, KindSpec, LinearLock};
 use crate::math::{Mat3, Quat, Real, Vec3};
@@ -48,6 +48,60 @@ pub(crate) use block::Block;
 use block::{apply_point, point_impulse, point_inverse_mass, solve_hard, solve_point};
 pub(crate) use chain::{find_chains, Chain, ChainBlock};
 use one_d::{free_impulse, solve_free, solve_limit, FreeDrive, Line};
+
+/// The solver's hard blocks of the joints, by `JointConstraint::block`: a slice when one
+/// thread has them all, [`SharedBlocks`] when a joint colour is split over threads.
+pub(crate) trait BlockSlots {
+    fn slot(&mut self, i: usize) -> &mut Option<Block>;
+}
+
+impl BlockSlots for [Option<Block>] {
+    #[inline(always)]
+    fn slot(&mut self, i: usize) -> &mut Option<Block> {
+        &mut self[i]
+    }
+}
+
+/// The blocks seen by the pieces of a joint colour at once, each reaching the slots of
+/// its own joints only.
+#[derive(Clone, Copy)]
+pub(crate) struct SharedBlocks<'a> {
+    ptr: *mut Option<Block>,
+    len: usize,
+    _borrow: std::marker::PhantomData<&'a mut [Option<Block>]>,
+}
+
+// SAFETY: a `SharedBlocks` is a `&mut [Option<Block>]` (which is `Send`) split between
+// threads; sharing it is sound under `new`'s contract, which rules out two threads
+// reaching one slot.
+unsafe impl Send for SharedBlocks<'_> {}
+unsafe impl Sync for SharedBlocks<'_> {}
+
+impl<'a> SharedBlocks<'a> {
+    /// Shares `blocks`, borrowed exclusively for `'a`, between threads.
+    ///
+    /// # Safety
+    /// While copies of the result are used on several threads at once, each slot must be
+    /// reached through one copy only. A slot belongs to one joint (`prepare_joints` numbers
+    /// them), and a joint to one piece.
+    pub unsafe fn new(blocks: &'a mut [Option<Block>]) -> SharedBlocks<'a> {
+        SharedBlocks {
+            ptr: blocks.as_mut_ptr(),
+            len: blocks.len(),
+            _borrow: std::marker::PhantomData,
+        }
+    }
+}
+
+impl BlockSlots for SharedBlocks<'_> {
+    #[inline(always)]
+    fn slot(&mut self, i: usize) -> &mut Option<Block> {
+        assert!(i < self.len);
+        // SAFETY: in bounds, and by `new`'s contract slot `i` is reached through this
+        // copy alone; the reference lives no longer than this copy's borrow.
+        unsafe { &mut *self.ptr.add(i) }
+    }
+}
 
 /// A body as a joint sees it: pose, inverse masses, whether it moves. The world is one
 /// that never moves, at the origin.
@@ -261,8 +315,12 @@ impl JointConstraint {
 
     /// The joint's hard block at frame `fr`, from `blocks` (the solver's, emptied after
     /// each drift), made there if missing.
-    fn block<'b>(&self, fr: &Frame, blocks: &'b mut [Option<Block>]) -> Option<&'b Block> {
-        let slot = &mut blocks[self.block?];
+    fn block<'b, B: BlockSlots + ?Sized>(
+        &self,
+        fr: &Frame,
+        blocks: &'b mut B,
+    ) -> Option<&'b Block> {
+        let slot = blocks.slot(self.block?);
         if slot.is_none() {
             *slot = self.hard_rows(fr).map(|hard| Block::new(hard, fr));
         }
@@ -305,37 +363,21 @@ impl JointConstraint {
     }
 
     /// Runs `f` with both bodies' states; the world's is a still copy.
-    fn with_states<R>(
+    #[inline(always)]
+    fn with_states<R, S: PairAccess + ?Sized>(
         &self,
-        states: &mut [BodyState],
+        states: &mut S,
         f: impl FnOnce(&mut BodyState, &mut BodyState) -> R,
     ) -> R {
-        // Made only when needed: two of these per call cost the joint grid a tenth of its
-        // time in copies.
-        let still = || BodyState {
-            v: Vec3::ZERO,
-            w: Vec3::ZERO,
-            dp: Vec3::ZERO,
-            dr: Mat3::IDENTITY,
-            turned: Vec3::ZERO,
-        };
-        match (self.a, self.b) {
-            (Some(a), Some(b)) => match states.get_disjoint_mut([a, b]) {
-                Ok([x, y]) => f(x, y),
-                Err(_) => f(&mut still(), &mut still()),
-            },
-            (Some(a), None) => f(&mut states[a], &mut still()),
-            (None, Some(b)) => f(&mut still(), &mut states[b]),
-            (None, None) => f(&mut still(), &mut still()),
-        }
+        states.with_pair(self.a, self.b, f)
     }
 
     /// Applies the accumulated impulses again (every substep).
-    pub fn warm_start(
+    pub fn warm_start<S: PairAccess + ?Sized, B: BlockSlots + ?Sized>(
         &mut self,
         fr: &Frame,
-        states: &mut [BodyState],
-        blocks: &mut [Option<Block>],
+        states: &mut S,
+        blocks: &mut B,
     ) {
         self.point_mass = None;
         if self.plain_ball {
@@ -369,12 +411,12 @@ impl JointConstraint {
 
     /// One pass over the joint's rows; a chain's member leaves its free row and hard rows
     /// to its chain (`joint_chain.rs`).
-    pub fn solve(
+    pub fn solve<S: PairAccess + ?Sized, B: BlockSlots + ?Sized>(
         &mut self,
         fr: &Frame,
-        states: &mut [BodyState],
+        states: &mut S,
         pass: &JointPass,
-        blocks: &mut [Option<Block>],
+        blocks: &mut B,
     ) {
         if self.plain_ball {
             let k_inv = *self
@@ -444,7 +486,7 @@ impl JointConstraint {
 
     /// Adds the substep's impulses to the step's totals: the force on `other` at its
     /// anchor and the pure torques.
-    pub fn add_to_totals(&mut self, fr: &Frame, blocks: &mut [Option<Block>]) {
+    pub fn add_to_totals<B: BlockSlots + ?Sized>(&mut self, fr: &Frame, blocks: &mut B) {
         let imp = self.impulses;
         if self.plain_ball {
             // The point's impulse is all there is, and it is already a world vector.

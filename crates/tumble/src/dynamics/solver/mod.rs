@@ -22,6 +22,7 @@ mod body;
 mod contact;
 mod contact_wide;
 mod joint;
+mod joint_colours;
 mod lanes;
 mod mass_ratio;
 mod overlap;
@@ -39,12 +40,13 @@ use softness::LoadSpring;
 pub use softness::Softness;
 
 pub(crate) use body::BODIES_A_PIECE;
-pub(crate) use body::{BodySim, BodyState, SolverBodies};
+pub(crate) use body::{BodySim, BodyState, SharedStates, SolverBodies};
 use contact::{BiasRule, ContactConstraint, PairData, Points};
 use joint::{
     find_chains, Block as JointBlock, Chain, ChainBlock, Frame as JointFrame, JointConstraint,
-    JointPass,
+    JointPass, SharedBlocks,
 };
+use joint_colours::JointRun;
 
 use crate::collision::contact::{Contact, ContactMaterial};
 use crate::collision::narrow_phase::Overlap;
@@ -99,6 +101,9 @@ pub(crate) struct Solver {
     /// `joint_blocks`).
     chains: Vec<Chain>,
     chain_blocks: Vec<Option<ChainBlock>>,
+    /// The joint list's colours and serial rests (see `joint_colours.rs`), and scratch.
+    joint_runs: Vec<JointRun>,
+    joint_used: Vec<u64>,
     /// Per body, whether its island has a large mass ratio (see `mass_ratio`); empty when
     /// none has. Such islands' contacts and joints sit at the end of their lists, from
     /// `heavy_contacts` and `heavy_joints`, and get `heavy_passes` times the passes.
@@ -263,9 +268,7 @@ impl Solver {
         if self.fine > 1 {
             self.fine_substeps(bodies, input, fine_rule);
         }
-        for (j, fr) in self.joints.iter_mut().zip(&self.joint_frames) {
-            j.warm_start(fr, &mut bodies.states, &mut self.joint_blocks);
-        }
+        self.warm_start_joints(&mut bodies.states);
         contact_wide::warm_start(
             &self.constraints,
             0..self.tall_contacts,
@@ -287,9 +290,21 @@ impl Solver {
         if iterations == 0 {
             ContactConstraint::add_to_totals(&self.points.hot, &mut self.points.cold);
         }
-        for (j, fr) in self.joints.iter_mut().zip(&self.joint_frames) {
-            j.add_to_totals(fr, &mut self.joint_blocks);
-        }
+        self.add_joint_totals();
+    }
+
+    /// Adds each joint's substep impulses to its totals, in pieces on the step's team.
+    fn add_joint_totals(&mut self) {
+        let (n, frames) = (self.joints.len(), &self.joint_frames);
+        let size = n.div_ceil(self.par.pieces(n, FRAMES_A_PIECE));
+        // SAFETY: each block slot belongs to one joint, and each joint to one piece.
+        let blocks = unsafe { SharedBlocks::new(&mut self.joint_blocks) };
+        crate::team::chunks(self.par.threads, &mut self.joints, size, &|start, part| {
+            let mut blocks = blocks;
+            for (j, fr) in part.iter_mut().zip(&frames[start..]) {
+                j.add_to_totals(fr, &mut blocks);
+            }
+        });
     }
 
     /// `iterations` passes over the joints then the contacts, with `bias` or without
@@ -332,38 +347,106 @@ impl Solver {
         ];
         for (contacts, joints, count, (rule, joint_pass, locked_pass)) in parts {
             for k in 0..count {
-                let hub = &self.hub;
-                let pass = |j: &JointConstraint| {
-                    if j.locks_rotation() && j.on(hub) {
-                        locked_pass
-                    } else {
-                        joint_pass
-                    }
-                };
-                for i in joints.clone() {
-                    if let Some(c) = self.joints[i].chain {
-                        self.chains[c].solve_free(
-                            i,
-                            (&mut self.joints, &self.joint_frames),
-                            &mut bodies.states,
-                            pass,
-                            (&mut self.joint_blocks, &mut self.chain_blocks[c]),
-                        );
-                    }
-                    let (j, fr) = (&mut self.joints[i], &self.joint_frames[i]);
-                    j.solve(fr, &mut bodies.states, pass(j), &mut self.joint_blocks);
-                    // A chain's block comes after its last joint's other rows.
-                    if let Some(c) = j.chain.filter(|&c| self.chains[c].last() == i) {
-                        self.chains[c].solve(
-                            (&mut self.joints, &self.joint_frames),
-                            &mut bodies.states,
-                            pass,
-                            (&mut self.joint_blocks, &mut self.chain_blocks[c]),
-                        );
-                    }
-                }
+                self.solve_joints(
+                    &mut bodies.states,
+                    joints.clone(),
+                    (joint_pass, locked_pass),
+                );
                 let last = totals && k + 1 == count;
                 self.solve_pass(bodies, contacts.clone(), rule, bias, last);
+            }
+        }
+    }
+
+    /// Warm starts the joints, colour by colour (see `joint_colours.rs`).
+    fn warm_start_joints(&mut self, states: &mut [BodyState]) {
+        for run in &self.joint_runs {
+            let r = run.range.clone();
+            let (joints, frames) = (&mut self.joints[r.clone()], &self.joint_frames[r]);
+            if run.splits(self.par) {
+                let each =
+                    |j: &mut JointConstraint,
+                     fr: &JointFrame,
+                     s: &mut SharedStates<'_>,
+                     b: &mut SharedBlocks<'_>| { j.warm_start(fr, s, b) };
+                let stripes = (&run.stripes[..], run.range.start);
+                for_colour(
+                    (joints, frames),
+                    stripes,
+                    (states, &mut self.joint_blocks),
+                    self.par,
+                    &each,
+                );
+                continue;
+            }
+            for (j, fr) in joints.iter_mut().zip(frames) {
+                j.warm_start(fr, states, &mut self.joint_blocks[..]);
+            }
+        }
+    }
+
+    /// One pass over the joints of `part` (the light or the heavy islands'), colour by
+    /// colour, then the part's serial rest with its chains (see `joint_colours.rs`).
+    /// Joints that lock rotation get `locked_pass` in an island with a hub, the others
+    /// `joint_pass`.
+    fn solve_joints(
+        &mut self,
+        states: &mut [BodyState],
+        part: Range<usize>,
+        (joint_pass, locked_pass): (&JointPass, &JointPass),
+    ) {
+        let hub = &self.hub;
+        let pass = |j: &JointConstraint| {
+            if j.locks_rotation() && j.on(hub) {
+                locked_pass
+            } else {
+                joint_pass
+            }
+        };
+        for run in self
+            .joint_runs
+            .iter()
+            .filter(|r| part.contains(&r.range.start))
+        {
+            let r = run.range.clone();
+            if run.splits(self.par) {
+                let each =
+                    |j: &mut JointConstraint,
+                     fr: &JointFrame,
+                     s: &mut SharedStates<'_>,
+                     b: &mut SharedBlocks<'_>| { j.solve(fr, s, pass(j), b) };
+                let joints = (&mut self.joints[r.clone()], &self.joint_frames[r]);
+                let stripes = (&run.stripes[..], run.range.start);
+                for_colour(
+                    joints,
+                    stripes,
+                    (states, &mut self.joint_blocks),
+                    self.par,
+                    &each,
+                );
+                continue;
+            }
+            for i in r {
+                if let Some(c) = self.joints[i].chain {
+                    self.chains[c].solve_free(
+                        i,
+                        (&mut self.joints, &self.joint_frames),
+                        states,
+                        pass,
+                        (&mut self.joint_blocks, &mut self.chain_blocks[c]),
+                    );
+                }
+                let (j, fr) = (&mut self.joints[i], &self.joint_frames[i]);
+                j.solve(fr, states, pass(j), &mut self.joint_blocks[..]);
+                // A chain's block comes after its last joint's other rows.
+                if let Some(c) = j.chain.filter(|&c| self.chains[c].last() == i) {
+                    self.chains[c].solve(
+                        (&mut self.joints, &self.joint_frames),
+                        states,
+                        pass,
+                        (&mut self.joint_blocks, &mut self.chain_blocks[c]),
+                    );
+                }
             }
         }
     }
@@ -727,6 +810,13 @@ impl Solver {
         self.joint_blocks.clear();
         self.joint_blocks.resize(blocks, None);
         self.chains = find_chains(&mut self.joints, &solver_bodies.sims);
+        let (n, heavy) = (self.joints.len(), self.heavy_joints);
+        self.joint_runs = joint_colours::order(
+            &mut self.joints,
+            &mut self.chains,
+            [0..heavy, heavy..n],
+            (solver_bodies.sims.len(), &mut self.joint_used),
+        );
         self.chain_blocks.clear();
         self.chain_blocks.resize(self.chains.len(), None);
         self.make_joint_frames(&solver_bodies.sims);
@@ -742,9 +832,18 @@ impl Solver {
                 .extend(self.joints.iter().map(|j| j.frame(sims)));
             return;
         }
-        for (j, fr) in self.joints.iter().zip(&mut self.joint_frames) {
-            j.write_frame(sims, fr);
-        }
+        let joints = &self.joints;
+        let size = n.div_ceil(self.par.pieces(n, FRAMES_A_PIECE));
+        crate::team::chunks(
+            self.par.threads,
+            &mut self.joint_frames,
+            size,
+            &|start, part| {
+                for (j, fr) in joints[start..].iter().zip(part) {
+                    j.write_frame(sims, fr);
+                }
+            },
+        );
         self.joint_blocks.fill(None);
         self.chain_blocks.fill(None);
     }
@@ -904,6 +1003,49 @@ impl Solver {
 /// Fewest contacts worth a piece of `store_contacts` on another thread (one is some
 /// 50 ns, a tenth of its preparation).
 const STORES_A_PIECE: usize = 512;
+
+/// Fewest joints worth a piece of a colour on another thread: a ball joint's pass takes
+/// about 50 ns, a piece's hand-off to the team about a microsecond.
+const JOINTS_A_PIECE: usize = 128;
+
+/// Fewest joints worth a piece of the frames and the totals on another thread (each
+/// joint's share is tens of nanoseconds).
+const FRAMES_A_PIECE: usize = 512;
+
+/// Calls `each` on every joint of one colour with its frame, a stripe (`stripes`: where
+/// each starts, offset by `base`) to a piece on the step's team, in order in each; in
+/// order on the calling thread when the step is serial.
+fn for_colour<F>(
+    (joints, frames): (&mut [JointConstraint], &[JointFrame]),
+    (stripes, base): (&[usize], usize),
+    (states, blocks): (&mut [BodyState], &mut [Option<JointBlock>]),
+    par: Par,
+    each: &F,
+) where
+    F: Fn(&mut JointConstraint, &JointFrame, &mut SharedStates<'_>, &mut SharedBlocks<'_>) + Sync,
+{
+    let n = joints.len();
+    let threads = if Par::split_at(n, JOINTS_A_PIECE) < 2 {
+        1
+    } else {
+        par.threads
+    };
+    let bounds = |i: usize| stripes[i] - base..stripes.get(i + 1).map_or(n, |&s| s - base);
+    // SAFETY: the stripes of a colour share no body, moving or not (`joint_colours::order`),
+    // so each state is reached through one piece's joints alone, and each block slot
+    // belongs to one joint.
+    let (states, blocks) = unsafe { (SharedStates::new(states), SharedBlocks::new(blocks)) };
+    let parts = Parts::new(joints);
+    crate::team::pieces(threads, stripes.len(), &|i| {
+        let range = bounds(i);
+        // SAFETY: piece i takes stripe i alone (each piece runs once).
+        let joints = unsafe { parts.part(range.clone()) };
+        let (mut s, mut b) = (states, blocks);
+        for (j, fr) in joints.iter_mut().zip(&frames[range]) {
+            each(j, fr, &mut s, &mut b);
+        }
+    });
+}
 
 /// Fewest constraints worth a piece of the preparation on another thread (one is some
 /// half a microsecond; a hand-off to the team about one).
