@@ -802,3 +802,44 @@ fn a_servo_target_across_half_a_turn_is_reached_the_short_way() {
         );
     }
 }
+
+#[test]
+fn a_joint_position_is_set_right_after_an_unjoined_body_is_removed() {
+    // Removing a body shifts the dense indices of those created after it; the joints'
+    // links must follow at once, not at the next step: setting a coordinate walks them.
+    let eps = tol(1e-9, 1e-5);
+    let mut w = awake(Vec3::new(0.0, -G, 0.0));
+    let loner = slab(&mut w, Vec3::new(0.0, 5.0, 0.0), Vec3::splat(0.2), 1.0);
+    let (links, joints) = three_links(&mut w, free_hinge());
+    run(&mut w, 1.0 / 60.0, 30);
+    w.remove_body(loner).unwrap();
+    let link0 = w.body(links[0]).unwrap().position();
+    w.set_joint_position(joints[1], JointCoordinate::Scalar(0.4))
+        .unwrap();
+    assert!((angle(&w, joints[1]) - 0.4).abs() < eps);
+    assert_eq!(
+        w.body(links[0]).unwrap().position(),
+        link0,
+        "the inner link moved"
+    );
+    // And a joint made right after the removal joins the bodies it names: a fourth link
+    // hinged to the third's free end, set to a quarter turn, swings alone.
+    let tip = w.body(links[2]).unwrap();
+    let end = tip.position() + tip.orientation() * Vec3::new(1.0, 0.0, 0.0);
+    let fourth = slab(&mut w, end, Vec3::new(1.0, 0.1, 0.1), 1.0);
+    let mut def = JointDef::new(free_hinge(), fourth);
+    def.anchor = Vec3::new(-0.5, 0.0, 0.0);
+    def.other = Some(links[2]);
+    def.other_anchor = Vec3::new(0.5, 0.0, 0.0);
+    (def.axis, def.other_axis) = (Vec3::Z, Vec3::Z);
+    let outer = w.create_joint(&def).unwrap();
+    let third = w.body(links[2]).unwrap().position();
+    w.set_joint_position(outer, JointCoordinate::Scalar(1.0))
+        .unwrap();
+    assert!((angle(&w, outer) - 1.0).abs() < eps);
+    assert_eq!(
+        w.body(links[2]).unwrap().position(),
+        third,
+        "the third link moved"
+    );
+}
