@@ -209,7 +209,8 @@ impl<'a> SharedStates<'a> {
     /// copy writes (`set_velocity`) must be read or written through no other copy, and an
     /// element one copy reads may be written by none. `ContactLanes` checks this of each
     /// run of groups it splits (each moving body in one lane of one group, no body both
-    /// moving in one lane and read in another) before any run is split.
+    /// moving in one lane and read in another) before any run is split; the joints split
+    /// a colour's stripes, which share no body at all (`joint_colours.rs`).
     pub unsafe fn new(states: &'a mut [BodyState]) -> SharedStates<'a> {
         SharedStates {
             ptr: states.as_mut_ptr(),
