@@ -44,6 +44,7 @@ use super::body::{BodySim, BodyState, PairAccess};
 use super::softness::Softness;
 use crate::dynamics::joint::{AngularLock, Joint, JointImpulses, KindSpec, LinearLock};
 use crate::math::{Mat3, Quat, Real, Vec3};
+use crate::team::Parts;
 pub(crate) use block::Block;
 use block::{apply_point, point_impulse, point_inverse_mass, solve_hard, solve_point};
 pub(crate) use chain::{find_chains, Chain, ChainBlock};
@@ -62,44 +63,29 @@ impl BlockSlots for [Option<Block>] {
     }
 }
 
-/// The blocks seen by the pieces of a joint colour at once, each reaching the slots of
-/// its own joints only.
+/// The blocks seen by the pieces of a joint colour at once, through the team's
+/// [`Parts`], each piece reaching the slots of its own joints only.
 #[derive(Clone, Copy)]
-pub(crate) struct SharedBlocks<'a> {
-    ptr: *mut Option<Block>,
-    len: usize,
-    _borrow: std::marker::PhantomData<&'a mut [Option<Block>]>,
-}
+pub(crate) struct SharedBlocks<'p, 'a>(&'p Parts<'a, Option<Block>>);
 
-// SAFETY: a `SharedBlocks` is a `&mut [Option<Block>]` (which is `Send`) split between
-// threads; sharing it is sound under `new`'s contract, which rules out two threads
-// reaching one slot.
-unsafe impl Send for SharedBlocks<'_> {}
-unsafe impl Sync for SharedBlocks<'_> {}
-
-impl<'a> SharedBlocks<'a> {
-    /// Shares `blocks`, borrowed exclusively for `'a`, between threads.
+impl<'p, 'a> SharedBlocks<'p, 'a> {
+    /// Shares the blocks in `parts` between the pieces of a job.
     ///
     /// # Safety
     /// While copies of the result are used on several threads at once, each slot must be
     /// reached through one copy only. A slot belongs to one joint (`prepare_joints` numbers
     /// them), and a joint to one piece.
-    pub unsafe fn new(blocks: &'a mut [Option<Block>]) -> SharedBlocks<'a> {
-        SharedBlocks {
-            ptr: blocks.as_mut_ptr(),
-            len: blocks.len(),
-            _borrow: std::marker::PhantomData,
-        }
+    pub unsafe fn new(parts: &'p Parts<'a, Option<Block>>) -> SharedBlocks<'p, 'a> {
+        SharedBlocks(parts)
     }
 }
 
-impl BlockSlots for SharedBlocks<'_> {
+impl BlockSlots for SharedBlocks<'_, '_> {
     #[inline(always)]
     fn slot(&mut self, i: usize) -> &mut Option<Block> {
-        assert!(i < self.len);
-        // SAFETY: in bounds, and by `new`'s contract slot `i` is reached through this
-        // copy alone; the reference lives no longer than this copy's borrow.
-        unsafe { &mut *self.ptr.add(i) }
+        // SAFETY: by `new`'s contract slot `i` is reached through this copy alone, so no
+        // other live slice covers it (`part` checks the bounds).
+        unsafe { &mut self.0.part(i..i + 1)[0] }
     }
 }
 

@@ -297,8 +297,9 @@ impl Solver {
     fn add_joint_totals(&mut self) {
         let (n, frames) = (self.joints.len(), &self.joint_frames);
         let size = n.div_ceil(self.par.pieces(n, FRAMES_A_PIECE));
+        let blocks = Parts::new(&mut self.joint_blocks);
         // SAFETY: each block slot belongs to one joint, and each joint to one piece.
-        let blocks = unsafe { SharedBlocks::new(&mut self.joint_blocks) };
+        let blocks = unsafe { SharedBlocks::new(&blocks) };
         crate::team::chunks(self.par.threads, &mut self.joints, size, &|start, part| {
             let mut blocks = blocks;
             for (j, fr) in part.iter_mut().zip(&frames[start..]) {
@@ -368,7 +369,7 @@ impl Solver {
                     |j: &mut JointConstraint,
                      fr: &JointFrame,
                      s: &mut SharedStates<'_>,
-                     b: &mut SharedBlocks<'_>| { j.warm_start(fr, s, b) };
+                     b: &mut SharedBlocks<'_, '_>| { j.warm_start(fr, s, b) };
                 let stripes = (&run.stripes[..], run.range.start);
                 for_colour(
                     (joints, frames),
@@ -410,11 +411,12 @@ impl Solver {
         {
             let r = run.range.clone();
             if run.splits(self.par) {
-                let each =
-                    |j: &mut JointConstraint,
-                     fr: &JointFrame,
-                     s: &mut SharedStates<'_>,
-                     b: &mut SharedBlocks<'_>| { j.solve(fr, s, pass(j), b) };
+                let each = |j: &mut JointConstraint,
+                            fr: &JointFrame,
+                            s: &mut SharedStates<'_>,
+                            b: &mut SharedBlocks<'_, '_>| {
+                    j.solve(fr, s, pass(j), b)
+                };
                 let joints = (&mut self.joints[r.clone()], &self.joint_frames[r]);
                 let stripes = (&run.stripes[..], run.range.start);
                 for_colour(
@@ -1004,10 +1006,6 @@ impl Solver {
 /// 50 ns, a tenth of its preparation).
 const STORES_A_PIECE: usize = 512;
 
-/// Fewest joints worth a piece of a colour on another thread: a ball joint's pass takes
-/// about 50 ns, a piece's hand-off to the team about a microsecond.
-const JOINTS_A_PIECE: usize = 128;
-
 /// Fewest joints worth a piece of the frames and the totals on another thread (each
 /// joint's share is tens of nanoseconds).
 const FRAMES_A_PIECE: usize = 512;
@@ -1022,21 +1020,18 @@ fn for_colour<F>(
     par: Par,
     each: &F,
 ) where
-    F: Fn(&mut JointConstraint, &JointFrame, &mut SharedStates<'_>, &mut SharedBlocks<'_>) + Sync,
+    F: Fn(&mut JointConstraint, &JointFrame, &mut SharedStates<'_>, &mut SharedBlocks<'_, '_>)
+        + Sync,
 {
     let n = joints.len();
-    let threads = if Par::split_at(n, JOINTS_A_PIECE) < 2 {
-        1
-    } else {
-        par.threads
-    };
     let bounds = |i: usize| stripes[i] - base..stripes.get(i + 1).map_or(n, |&s| s - base);
+    let blocks = Parts::new(blocks);
     // SAFETY: the stripes of a colour share no body, moving or not (`joint_colours::order`),
     // so each state is reached through one piece's joints alone, and each block slot
     // belongs to one joint.
-    let (states, blocks) = unsafe { (SharedStates::new(states), SharedBlocks::new(blocks)) };
+    let (states, blocks) = unsafe { (SharedStates::new(states), SharedBlocks::new(&blocks)) };
     let parts = Parts::new(joints);
-    crate::team::pieces(threads, stripes.len(), &|i| {
+    crate::team::pieces(par.threads, stripes.len(), &|i| {
         let range = bounds(i);
         // SAFETY: piece i takes stripe i alone (each piece runs once).
         let joints = unsafe { parts.part(range.clone()) };
