@@ -161,14 +161,20 @@ impl Manifold {
     /// swapped.
     pub fn swapped(&self) -> Manifold {
         let mut m = *self;
-        m.normal = -self.normal;
-        m.angular_impulse = -self.angular_impulse;
-        std::mem::swap(&mut m.subshape_a, &mut m.subshape_b);
-        for p in m.points_mut() {
+        m.swap();
+        m
+    }
+
+    /// [`Manifold::swapped`] in place (the narrow phase's flipped pairs: a copy of the
+    /// whole manifold each was 0.35 % of the rain's step).
+    pub fn swap(&mut self) {
+        self.normal = -self.normal;
+        self.angular_impulse = -self.angular_impulse;
+        std::mem::swap(&mut self.subshape_a, &mut self.subshape_b);
+        for p in self.points_mut() {
             std::mem::swap(&mut p.point_a, &mut p.point_b);
             p.feature = swap_feature(p.feature);
         }
-        m
     }
 
     /// Deepest (most negative) separation, or +∞ when empty.

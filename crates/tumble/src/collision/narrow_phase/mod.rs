@@ -61,26 +61,30 @@ pub fn collide(
     let Some(ca) = Convex::from_shape(a) else {
         return; // static-only against static-only: nothing moves, nothing to report
     };
-    let mut m = Manifold::default();
-    let touching = match b {
-        Shape::Plane { normal, offset } => {
-            plane::convex_plane(&ca, pose_a, *normal, *offset, pose_b, margin, &mut m)
-        }
-        Shape::TriMesh(mesh) => {
-            mesh::convex_trimesh(&ca, pose_a, mesh, pose_b, margin, out);
-            false
-        }
+    match b {
+        Shape::TriMesh(mesh) => mesh::convex_trimesh(&ca, pose_a, mesh, pose_b, margin, out),
         Shape::HeightField(field) => {
-            mesh::convex_heightfield(&ca, pose_a, field, pose_b, margin, out);
-            false
+            mesh::convex_heightfield(&ca, pose_a, field, pose_b, margin, out)
         }
-        _ => match Convex::from_shape(b) {
-            Some(cb) => convex_pair(&ca, pose_a, &cb, pose_b, margin, &mut m),
-            None => false,
-        },
-    };
-    if touching && !m.is_empty() {
-        out.push(m);
+        _ => {
+            // Built in its place in `out` and taken back if empty: made on the stack and
+            // pushed, a manifold (some 800 bytes in f64) was copied once more per pair,
+            // 0.4 % of the rain's step.
+            out.push(Manifold::default());
+            let m = out.last_mut().expect("just pushed");
+            let touching = match b {
+                Shape::Plane { normal, offset } => {
+                    plane::convex_plane(&ca, pose_a, *normal, *offset, pose_b, margin, m)
+                }
+                _ => match Convex::from_shape(b) {
+                    Some(cb) => convex_pair(&ca, pose_a, &cb, pose_b, margin, m),
+                    None => false,
+                },
+            };
+            if !touching || m.is_empty() {
+                out.pop();
+            }
+        }
     }
 }
 
@@ -96,7 +100,7 @@ fn collide_swapped(
     let start = out.len();
     collide(b, pose_b, a, pose_a, margin, out);
     for m in &mut out[start..] {
-        *m = m.swapped();
+        m.swap();
     }
 }
 
@@ -111,7 +115,7 @@ pub(crate) fn convex_pair(
 ) -> bool {
     use Convex as C;
     let flipped = |out: &mut Manifold, hit: bool| {
-        *out = out.swapped();
+        out.swap();
         hit
     };
     match (a, b) {

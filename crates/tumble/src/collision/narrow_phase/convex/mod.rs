@@ -91,7 +91,7 @@ pub fn convex_convex(
     let (sub_a, sub_b) = (out.subshape_a, out.subshape_b);
     let hit = if rank(b) < rank(a) {
         let hit = ordered(b, pb, a, pa, margin, out);
-        *out = out.swapped();
+        out.swap();
         hit
     } else {
         ordered(a, pa, b, pb, margin, out)
