@@ -390,8 +390,6 @@ impl Point<Lanes> {
 }
 
 impl Group {
-    /// A group of `lanes` constraints from `first` with `slots` slots from `slot0`, to
-    /// be filled by [`Group::fill`].
     /// Makes `groups[k]` the group of `lanes` constraints from `first`, with `slots`
     /// slots from `slot0`: an old entry gets these four fields (`fill` writes the rest
     /// whole), a new one is pushed.
