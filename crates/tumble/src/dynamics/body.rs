@@ -378,6 +378,12 @@ impl Body {
             self.filter
         }
     }
+    /// A quarter of the body's thinnest extent (m): the depth past which contact and
+    /// continuous collision treat a thin body as sunk, where that is less than their own
+    /// bound (`pipeline/ccd.rs`, `pipeline/contact_cache.rs`, the tall stacks' supports).
+    pub(crate) fn quarter_thickness(&self) -> Real {
+        0.5 * self.ccd_extent
+    }
     /// Whether the body is confined to the XY plane.
     pub fn is_planar(&self) -> bool {
         self.planar

@@ -60,7 +60,7 @@ use crate::math::{quat_from_rotation_vector, Real, Vec3};
 /// `margin` (m); see the module header.
 fn allowance(body: &Body, slop: Real, margin: Real) -> Allowance {
     // `ccd_extent` is half the body's thinnest extent.
-    let depth = slop.min(0.5 * body.ccd_extent);
+    let depth = slop.min(body.quarter_thickness());
     Allowance {
         gap: slop,
         near: 0.5 * margin,

@@ -391,7 +391,7 @@ fn crowding(limits: &ContactLimits, margin: Real) -> Crowding {
 /// `Aabb::sunk_into`'s, from the bodies' sizes rather than their boxes'; resting contacts
 /// sink by about the slop (5 mm), below it for any body thicker than 2 cm.
 fn deep(a: &Body, b: &Body, margin: Real) -> Real {
-    margin.min(0.5 * a.ccd_extent.min(b.ccd_extent))
+    margin.min(a.quarter_thickness().min(b.quarter_thickness()))
 }
 
 /// Whether a contact has a point deeper than `depth`.

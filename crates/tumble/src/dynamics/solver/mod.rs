@@ -506,13 +506,13 @@ impl Solver {
             if gap <= 0.0 {
                 return true;
             }
-            let thinnest = [c.index_a, c.index_b]
+            let quarter = [c.index_a, c.index_b]
                 .into_iter()
                 .map(|k| &world_bodies[k as usize])
                 .filter(|b| b.kind == BodyKind::Dynamic)
-                .map(|b| b.ccd_extent)
+                .map(Body::quarter_thickness)
                 .fold(Real::INFINITY, Real::min);
-            gap <= slop.min(0.5 * thinnest)
+            gap <= slop.min(quarter)
         };
         let supports: Vec<stacks::Support> = contacts
             .iter()
