@@ -136,8 +136,9 @@ impl BorrowMut<Sums> for PointCold {
 }
 
 /// Every contact point of the step, manifold by manifold, hot and cold parts in step;
-/// `lanes` holds the wide passes' copy of the grouped manifolds' points, whose impulses
-/// are the current ones until [`Points::save_lanes`] copies them back; `angular` the
+/// `lanes` holds the grouped manifolds' points, which the preparation writes there alone
+/// (their entries in `hot` are stale until [`Points::save_lanes`] copies them back whole,
+/// and their sums in `cold` too; the rest of `cold` is theirs); `angular` the
 /// rolling and twist rows of the manifolds that have them (see `super::angular`).
 /// Where a manifold's points are written: its own entries of `Points::hot` and `cold`.
 pub(crate) type PointsOut<'a> = (&'a mut [Point], &'a mut [PointCold]);
@@ -158,16 +159,8 @@ impl Points {
         self.angular.clear();
     }
 
-    /// Groups the constraints (in the solver's order) for the wide passes; no group
-    /// spans either of `splits`, where the passes of the heavy islands and the tall
-    /// stacks start.
-    pub fn group_lanes(&mut self, constraints: &[ContactConstraint], splits: [usize; 2], par: Par) {
-        let angular = !self.angular.is_empty();
-        self.lanes
-            .build(constraints, (splits, angular), (&self.hot, &self.cold), par);
-    }
-
-    /// Brings the grouped points' impulses and totals back from the lanes.
+    /// Brings the grouped points back from the lanes, whole (see
+    /// `ContactLanes::write_back`).
     pub fn save_lanes(&mut self, constraints: &[ContactConstraint], par: Par) {
         self.lanes
             .write_back(constraints, (&mut self.hot, &mut self.cold), par);
@@ -223,9 +216,6 @@ pub(crate) struct ContactConstraint {
     pub(super) restitution: Real,
     first: usize,
     count: usize,
-    /// Graph colour (see `Solver::colour_order`): constraints of one colour below 63
-    /// share no moving body.
-    colour: u32,
     /// The manifold's rolling and twist rows in `Points::angular`, if its pair has either.
     angular: Option<u32>,
 }
@@ -316,7 +306,7 @@ impl ContactConstraint {
     /// Anchors, Jacobians, effective masses and the warm-start impulses of a manifold;
     /// its points are appended to `points`.
     pub fn prepare(
-        (index, colour): (usize, u32),
+        index: usize,
         contact: &Contact,
         pair: &PairData,
         (sims, states): (&[BodySim], &[BodyState]),
@@ -356,7 +346,6 @@ impl ContactConstraint {
             restitution,
             first,
             count: m.len(),
-            colour,
             angular: angular_rows(m, pair, (sa, sb), tangents, angular),
         };
         // Two builds of one loop: with the test for rolled anchors folded into the
@@ -370,10 +359,9 @@ impl ContactConstraint {
         c
     }
 
-    /// Stiffens the manifold's spring for the load its points carried last step (an
-    /// island with a large mass ratio: see `mass_ratio.rs`).
-    pub fn stiffen(&mut self, spring: &LoadSpring, points: &Points) {
-        let added = &points.hot[self.range()];
+    /// Stiffens the manifold's spring for the load its points (`added`, as prepared)
+    /// carried last step (an island with a large mass ratio: see `mass_ratio.rs`).
+    pub fn stiffen(&mut self, spring: &LoadSpring, added: &[Point]) {
         let load = added.iter().map(|p| p.normal_impulse).sum();
         let mass = added.iter().map(|p| p.normal.mass).sum();
         self.frame.impulse_scale = spring.impulse_scale(load, mass);
@@ -382,13 +370,14 @@ impl ContactConstraint {
     /// Scales the manifold's warm-start impulses by `k`: last step's were per substep of
     /// another length (a tall stack's finer substeps, see `stacks.rs`), and an impulse per
     /// substep goes as the substep's length.
-    pub fn rescale_warm_start(&self, points: &mut Points, k: Real) {
-        for p in &mut points.hot[self.range()] {
+    /// Its points are `hot` (as prepared), its rolling and twist rows in `angular`.
+    pub fn rescale_warm_start(&self, (hot, angular): (&mut [Point], &mut [AngularRows]), k: Real) {
+        for p in hot {
             p.normal_impulse *= k;
             p.tangent_impulse = p.tangent_impulse.map(|t| t * k);
         }
         if let Some(i) = self.angular {
-            points.angular[i as usize].rescale(k);
+            angular[i as usize].rescale(k);
         }
     }
 
@@ -459,11 +448,6 @@ impl ContactConstraint {
         }
     }
 
-    /// Whether the manifold has rolling or twist rows (and so stays on the scalar path).
-    pub fn has_angular(&self) -> bool {
-        self.angular.is_some()
-    }
-
     /// Dense indices of the two bodies.
     pub fn bodies(&self) -> (usize, usize) {
         (self.a, self.b)
@@ -472,11 +456,6 @@ impl ContactConstraint {
     /// The manifold's points' indices in [`Points`].
     pub fn range(&self) -> std::ops::Range<usize> {
         self.first..self.first + self.count
-    }
-
-    /// Graph colour (see `Solver::colour_order`).
-    pub fn colour(&self) -> u32 {
-        self.colour
     }
 
     /// Whether the solver moves body a, body b.
@@ -540,25 +519,26 @@ impl ContactConstraint {
         rows::add_totals(hot, cold);
     }
 
-    /// Writes the impulses into the contact for next step's warm start and for reports.
-    pub fn store_impulses(&self, points: &Points, contact: &mut Contact) {
-        let hot = &points.hot[self.range()];
-        let cold = &points.cold[self.range()];
-        for (mp, (p, c)) in contact
-            .manifold
-            .points_mut()
-            .iter_mut()
-            .zip(hot.iter().zip(cold))
-        {
-            mp.normal_impulse = p.normal_impulse;
-            mp.tangent_impulse = p.tangent_impulse;
-            mp.total_normal_impulse = c.sums.total_normal;
-            let cone = self.frame.friction * p.normal_impulse;
-            let friction = (p.tangent_impulse[0].powi(2) + p.tangent_impulse[1].powi(2)).sqrt();
-            mp.sliding = p.normal_impulse == 0.0 || friction >= 0.999 * cone || c.rolled;
+    /// Writes the impulses into the contact for next step's warm start and for reports;
+    /// `k` is the constraint's index (a grouped one's impulses are in its lane).
+    pub fn store_impulses(&self, k: usize, points: &Points, contact: &mut Contact) {
+        let first = self.first;
+        let points_mut = contact.manifold.points_mut().iter_mut();
+        for (j, mp) in points_mut.enumerate() {
+            let (p, c) = (&points.hot[first + j], &points.cold[first + j]);
+            let (normal, tangent, sums) =
+                points
+                    .lanes
+                    .solved(k, j)
+                    .unwrap_or((p.normal_impulse, p.tangent_impulse, c.sums));
+            mp.normal_impulse = normal;
+            mp.tangent_impulse = tangent;
+            mp.total_normal_impulse = sums.total_normal;
+            let cone = self.frame.friction * normal;
+            let friction = (tangent[0].powi(2) + tangent[1].powi(2)).sqrt();
+            mp.sliding = normal == 0.0 || friction >= 0.999 * cone || c.rolled;
             let t = self.frame.tangents;
-            mp.total_tangent_impulse =
-                t[0] * c.sums.total_tangent[0] + t[1] * c.sums.total_tangent[1];
+            mp.total_tangent_impulse = t[0] * sums.total_tangent[0] + t[1] * sums.total_tangent[1];
         }
         match self.angular {
             Some(k) => points.angular[k as usize].store(&mut contact.manifold),

@@ -41,7 +41,7 @@ pub use softness::Softness;
 
 pub(crate) use body::BODIES_A_PIECE;
 pub(crate) use body::{BodySim, BodyState, SharedStates, SolverBodies};
-use contact::{BiasRule, ContactConstraint, PairData, Points};
+use contact::{BiasRule, ContactConstraint, PairData, Point, PointCold, Points};
 use joint::{
     find_chains, Block as JointBlock, Chain, ChainBlock, Frame as JointFrame, JointConstraint,
     JointPass, SharedBlocks,
@@ -49,7 +49,7 @@ use joint::{
 use joint_colours::JointRun;
 
 use crate::collision::contact::{Contact, ContactMaterial};
-use crate::collision::narrow_phase::Overlap;
+use crate::collision::narrow_phase::{Overlap, MAX_MANIFOLD_POINTS};
 use crate::dynamics::body::Motion;
 use crate::dynamics::body::{Body, BodyKind};
 use crate::dynamics::force::Wrench;
@@ -128,6 +128,8 @@ pub(crate) struct Solver {
     /// (see `overlap`), and scratch.
     deep: Vec<overlap::Deep>,
     overlap: overlap::Scratch,
+    /// What planning the lane groups needs of each constraint (scratch of `prepare`).
+    planned: Vec<contact_wide::Planned>,
     /// Per contact, its constraint's index (`u32::MAX`: not solved), for `store_contacts`.
     of_contact: Vec<u32>,
     /// How this step's passes may split their work.
@@ -161,6 +163,7 @@ impl Solver {
                 overlap::Allowance::new(input.settings, time, input.scales.linear_slop),
                 LoadSpring::new(&rule.softness, time.h, gravity.length()),
             ),
+            input.settings.iterations,
         );
         self.prepare_joints(bodies, world_bodies, input.joints, input.joint_bodies);
         // The bounce replay starts from the step's start states; only a contact with
@@ -180,9 +183,10 @@ impl Solver {
         }
         self.moving.clear();
         self.moving.extend(bodies.sims.iter().map(|s| s.moves));
-        // The wide passes' impulses go back to the points first; the bounce pass and the
-        // contacts' impulses read them there.
-        self.points.save_lanes(&self.constraints, self.par);
+        // The bounce and overlap passes read the grouped points whole, as scalar points.
+        if !self.start_states.is_empty() || !self.deep.is_empty() {
+            self.points.save_lanes(&self.constraints, self.par);
+        }
         restitution::resolve_bounces(
             &self.constraints,
             &mut self.points,
@@ -239,7 +243,7 @@ impl Solver {
                 let m = &mut contact.manifold;
                 m.fine = if k as usize >= tall_contacts { fine } else { 1 };
                 m.overlap = Overlap::Clear;
-                c.store_impulses(points, contact);
+                c.store_impulses(k as usize, points, contact);
             }
         });
         for d in self.deep.iter().filter(|d| !d.guard) {
@@ -631,13 +635,14 @@ impl Solver {
 
     /// The step's contact constraints, in colour order, and their lane groups; `slop` (m)
     /// tells rolled friction anchors (see `contact::rolled_away`), the world's bodies
-    /// their shapes' round radii.
+    /// their shapes' round radii. With no `iterations` nothing is grouped.
     fn prepare(
         &mut self,
         (bodies, world_bodies): (&SolverBodies, &[Body]),
         (contacts, materials): (&[Contact], &[ContactMaterial]),
         ghosts: &[bool],
         (slop, gravity, allow, spring): (Real, Vec3, overlap::Allowance, LoadSpring),
+        iterations: u32,
     ) {
         self.points.clear_rows();
         self.deep.clear();
@@ -659,7 +664,7 @@ impl Solver {
         set_len(&mut self.constraints, order.len());
         set_len(&mut self.points.hot, total);
         set_len(&mut self.points.cold, total);
-        let sims = &bodies.sims;
+        let angular = self.plan_lanes(&order, contacts, &bodies.sims, iterations == 0);
         let with = PrepareWith {
             bodies: (bodies, world_bodies),
             contacts: (contacts, materials),
@@ -667,69 +672,64 @@ impl Solver {
             gravity,
             order: &order,
             firsts: &firsts,
+            fit: (self.fine, spring),
         };
         // Rolling and twist rows are listed in order in one list of their own: a step
         // with any is prepared on one thread.
-        let angular = order.iter().any(|&(_, _, i)| {
-            let c = &contacts[i];
-            let (r, t) = angular::combine(&sims[c.index_a as usize], &sims[c.index_b as usize]);
-            r > 0.0 || t > 0.0
-        });
         let pieces = if angular {
             1
         } else {
             self.par.pieces(order.len(), CONSTRAINTS_A_PIECE)
         };
+        let Points {
+            hot,
+            cold,
+            lanes,
+            angular,
+        } = &mut self.points;
+        let writer = lanes.writer();
         if pieces <= 1 {
-            let out = (&mut self.points.hot[..], &mut self.points.cold[..]);
-            with.piece(
-                0..order.len(),
-                &mut self.constraints,
-                out,
-                &mut self.points.angular,
-            );
+            let n = order.len();
+            // SAFETY: the only part, of the whole order.
+            let mut lanes = unsafe { writer.part(0..n, |k| firsts[k + 1] - firsts[k]) };
+            let out = (&mut hot[..], &mut cold[..]);
+            with.piece(0..n, (&mut self.constraints, &mut lanes), out, angular);
         } else {
-            self.prepare_in_pieces(&with, pieces);
+            prepare_in_pieces(&with, (&mut self.constraints, hot, cold), &writer, self.par);
         }
-        // What the pieces leave: each constraint fitted to its part, and the points that
-        // overlap too deeply found, in order (each touches its own constraint's points).
-        for (k, &(part, _, i)) in order.iter().enumerate() {
+        // The points that overlap too deeply, in order (each touches its own
+        // constraint's points).
+        for (k, &(_, _, i)) in order.iter().enumerate() {
             let c = &contacts[i];
-            self.fit_to_part(k, part, c.manifold.fine, &spring);
             if c.manifold.overlap != Overlap::Clear {
                 self.find_deep(c, (k, firsts[k]), &allow);
             }
         }
-        self.points.group_lanes(
-            &self.constraints,
-            [self.heavy_contacts, self.tall_contacts],
-            self.par,
-        );
+        self.points.lanes.fill(&self.constraints, self.par);
     }
 
-    /// [`PrepareWith::piece`] over `pieces` consecutive runs of the order on the step's
-    /// team, each writing its own constraints and their points (no pair of the step has
-    /// angular rows).
-    fn prepare_in_pieces(&mut self, with: &PrepareWith<'_>, pieces: usize) {
-        let n = with.order.len();
-        let size = n.div_ceil(pieces).max(1);
-        let constraints = Parts::new(&mut self.constraints[..]);
-        let hot = Parts::new(&mut self.points.hot[..]);
-        let cold = Parts::new(&mut self.points.cold[..]);
-        crate::team::pieces(self.par.threads, n.div_ceil(size), &|i| {
-            let range = i * size..((i + 1) * size).min(n);
-            let at = with.firsts[range.start]..with.firsts[range.end];
-            // SAFETY: piece i takes constraints i·size.. (i+1)·size alone, and the points
-            // from the first's first to the last's end: `firsts` rises, so the pieces'
-            // point ranges are disjoint too (each piece runs once).
-            let (cs, out) = unsafe {
-                (
-                    constraints.part(range.clone()),
-                    (hot.part(at.clone()), cold.part(at)),
-                )
-            };
-            with.piece(range, cs, out, &mut Vec::new());
-        });
+    /// Plans the lane groups (none when `off`) before the constraints are prepared, so
+    /// that the grouped points are prepared straight into their lanes; returns whether
+    /// any pair has rolling or twist rows (which stay scalar).
+    fn plan_lanes(
+        &mut self,
+        order: &[(u8, u32, usize)],
+        contacts: &[Contact],
+        sims: &[BodySim],
+        off: bool,
+    ) -> bool {
+        self.planned.clear();
+        self.planned.extend(order.iter().map(|&(_, colour, i)| {
+            let c = &contacts[i];
+            let (r, t) = angular::combine(&sims[c.index_a as usize], &sims[c.index_b as usize]);
+            (colour, c.manifold.len(), r > 0.0 || t > 0.0)
+        }));
+        let angular = self.planned.iter().any(|p| p.2);
+        let splits = [self.heavy_contacts, self.tall_contacts];
+        self.points
+            .lanes
+            .plan(&self.planned, (splits, angular), off);
+        angular
     }
 
     /// The points of constraint `k` (contact `c`, its points from `first`) deeper than
@@ -737,31 +737,20 @@ impl Solver {
     fn find_deep(&mut self, c: &Contact, (k, first): (usize, usize), allow: &overlap::Allowance) {
         for (j, mp) in c.manifold.points().iter().enumerate() {
             let start_velocity = self.points.cold[first + j].start_velocity;
-            let p = &mut self.points.hot[first + j];
             let at = (mp.separation, start_velocity);
-            if let Some(deep) = overlap::Deep::find((k, first + j), at, p, allow) {
-                p.separation = -deep.depth;
+            // A grouped point lives in its lane.
+            let lanes = &mut self.points.lanes;
+            let deep = match lanes.point(k, j) {
+                Some(p) => overlap::Deep::find((k, first + j), at, &p, allow),
+                None => overlap::Deep::find((k, first + j), at, &self.points.hot[first + j], allow),
+            };
+            if let Some(deep) = deep {
+                match lanes.point(k, j) {
+                    Some(_) => lanes.set_separation((k, j), -deep.depth),
+                    None => self.points.hot[first + j].separation = -deep.depth,
+                }
                 self.deep.push(deep);
             }
-        }
-    }
-
-    /// Fits constraint `k` to its `part`'s passes: warm starts made per substep of the
-    /// length it was last solved at (`was` times finer than the world's) brought to this
-    /// step's, and a heavy island's contacts stiffened for their load.
-    fn fit_to_part(&mut self, k: usize, part: u8, was: u8, spring: &LoadSpring) {
-        let fine = if part == Part::Tall as u8 {
-            self.fine
-        } else {
-            1
-        };
-        let was = u32::from(was.max(1));
-        if was != fine {
-            let share = was as Real / fine as Real;
-            self.constraints[k].rescale_warm_start(&mut self.points, share);
-        }
-        if part == Part::Heavy as u8 {
-            self.constraints[k].stiffen(spring, &self.points);
         }
     }
 
@@ -1076,38 +1065,117 @@ struct PrepareWith<'a> {
     gravity: Vec3,
     order: &'a [(u8, u32, usize)],
     firsts: &'a [usize],
+    /// How many times finer the tall stacks' substeps are, and the heavy islands' spring
+    /// (see [`PrepareWith::fit`]).
+    fit: (u32, LoadSpring),
+}
+
+/// [`PrepareWith::piece`] over `pieces` consecutive runs of the order on the step's team,
+/// each writing its own constraints and their points, scalar or in lanes (no pair of the
+/// step has angular rows). The runs are cut where no lane group straddles.
+fn prepare_in_pieces(
+    with: &PrepareWith<'_>,
+    (constraints, hot, cold): (&mut [ContactConstraint], &mut [Point], &mut [PointCold]),
+    writer: &contact_wide::LaneWriter<'_>,
+    par: Par,
+) {
+    let n = with.order.len();
+    let pieces = par.pieces(n, CONSTRAINTS_A_PIECE);
+    let size = n.div_ceil(pieces).max(1);
+    let count = n.div_ceil(size);
+    let bounds: Vec<usize> = (0..=count)
+        .map(|i| writer.boundary((i * size).min(n)))
+        .collect();
+    let constraints = Parts::new(constraints);
+    let (hot, cold) = (Parts::new(hot), Parts::new(cold));
+    crate::team::pieces(par.threads, count, &|i| {
+        let range = bounds[i]..bounds[i + 1];
+        if range.is_empty() {
+            return;
+        }
+        let at = with.firsts[range.start]..with.firsts[range.end];
+        // SAFETY: piece i takes the constraints between its bounds alone, and the points
+        // from the first's first to the last's end: `bounds` and `firsts` rise, so the
+        // pieces' point ranges are disjoint too; its lanes are those of its own groups,
+        // whole between bounds (each piece runs once).
+        let (cs, out, mut lanes) = unsafe {
+            (
+                constraints.part(range.clone()),
+                (hot.part(at.clone()), cold.part(at)),
+                writer.part(range.clone(), |k| with.firsts[k + 1] - with.firsts[k]),
+            )
+        };
+        with.piece(range, (cs, &mut lanes), out, &mut Vec::new());
+    });
 }
 
 impl PrepareWith<'_> {
     /// Prepares the constraints `range` of the order into `cs` and their points into
-    /// `out` (theirs alone, from the range's first point), rolling and twist rows onto
-    /// `angular`.
+    /// `out` (theirs alone, from the range's first point) or, for a grouped constraint,
+    /// into its lane in `lanes`; rolling and twist rows onto `angular`.
     fn piece(
         &self,
         range: Range<usize>,
-        cs: &mut [ContactConstraint],
+        (cs, lanes): (&mut [ContactConstraint], &mut contact_wide::LanePart<'_>),
         (hot, cold): contact::PointsOut<'_>,
         angular: &mut Vec<angular::AngularRows>,
     ) {
         let (bodies, _) = self.bodies;
         let base = self.firsts[range.start];
+        // A grouped manifold's points, on their way to the lanes.
+        let mut buffer = [Point::default(); MAX_MANIFOLD_POINTS];
         for (k, c_out) in range.zip(cs) {
             // The order jumps through the contacts: fetch a few ahead (waiting for the
             // manifolds was a fifth of the preparation's time on the pyramid).
             if let Some(&(_, _, ahead)) = self.order.get(k + PREFETCH_AHEAD) {
                 crate::math::prefetch(&self.contacts.0[ahead].manifold);
             }
-            let (_, colour, i) = self.order[k];
+            let (part, _, i) = self.order[k];
             let c = &self.contacts.0[i];
             let at = self.firsts[k] - base..self.firsts[k + 1] - base;
-            let out = (&mut hot[at.clone()], &mut cold[at]);
+            let grouped = lanes.grouped(k);
+            let points = if grouped {
+                &mut buffer[..at.len()]
+            } else {
+                &mut hot[at.clone()]
+            };
             *c_out = ContactConstraint::prepare(
-                (i, colour),
+                i,
                 c,
                 &self.pair(i),
                 (&bodies.sims, &bodies.states),
-                (self.firsts[k], out, angular),
+                (
+                    self.firsts[k],
+                    (&mut *points, &mut cold[at.clone()]),
+                    angular,
+                ),
             );
+            self.fit(c_out, (part, c.manifold.fine), (&mut *points, angular));
+            if grouped {
+                lanes.put(k, points, &cold[at]);
+            }
+        }
+    }
+
+    /// Fits constraint `c` (its points as prepared, its rolling and twist rows in
+    /// `angular`) to its `part`'s passes: warm starts made per substep of the length it
+    /// was last solved at (`was` times finer than the world's) brought to this step's,
+    /// and a heavy island's contacts stiffened for their load.
+    fn fit(
+        &self,
+        c: &mut ContactConstraint,
+        (part, was): (u8, u8),
+        (points, angular): (&mut [Point], &mut [angular::AngularRows]),
+    ) {
+        let (fine, spring) = &self.fit;
+        let fine = if part == Part::Tall as u8 { *fine } else { 1 };
+        let was = u32::from(was.max(1));
+        if was != fine {
+            let share = was as Real / fine as Real;
+            c.rescale_warm_start((&mut *points, angular), share);
+        }
+        if part == Part::Heavy as u8 {
+            c.stiffen(spring, points);
         }
     }
 

@@ -28,7 +28,7 @@ pub(crate) const TOLERANCE: Real = 1e-4;
 const MAX_PASSES: usize = 64;
 
 /// Resolves the step's bounces; `start` holds the velocities of the step's start. The
-/// wide passes' impulses must be back in the points (`Points::save_lanes`).
+/// grouped points must be back in the scalar points (`Points::save_lanes`).
 pub(crate) fn resolve_bounces(
     constraints: &[ContactConstraint],
     points: &mut Points,
