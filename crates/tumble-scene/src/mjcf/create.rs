@@ -163,6 +163,8 @@ fn create_body(
         collision_group: filter.0,
         collision_mask: filter.1,
         friction: b.geoms.iter().map(|g| g.friction).fold(0.0, Real::max),
+        torsional_friction: b.geoms.iter().map(|g| g.torsional).fold(0.0, Real::max),
+        rolling_resistance: rolling_resistance(b),
         ..BodyDef::default()
     };
     if b.geoms.is_empty() {
@@ -205,6 +207,21 @@ fn create_body(
     Ok(Some(id))
 }
 
+/// The body's rolling resistance: the largest of its colliding geoms' rolling friction
+/// over the radius each rolls on (see `geom::rolling_radius`). A static body's is left
+/// to the body that rolls on it: Tumble's radius is the moving body's.
+fn rolling_resistance(b: &PlanBody) -> Real {
+    if !b.dynamic {
+        return 0.0;
+    }
+    let each = b
+        .geoms
+        .iter()
+        .filter(|g| g.rolling > 0.0 && g.contype | g.conaffinity != 0);
+    each.filter_map(|g| Some(g.rolling / super::geom::rolling_radius(g.shape.as_ref()?)?))
+        .fold(0.0, Real::max)
+}
+
 /// A static body's planes, each a static body of its own (planes join no compound).
 fn static_planes(b: &PlanBody, def: &BodyDef, world: &mut World, made: &mut Made) -> Result<()> {
     for g in &b.geoms {
@@ -215,6 +232,8 @@ fn static_planes(b: &PlanBody, def: &BodyDef, world: &mut World, made: &mut Made
             name: None,
             kind: BodyKind::Static,
             friction: g.friction,
+            torsional_friction: g.torsional,
+            rolling_resistance: 0.0,
             collision_group: def.collision_group,
             collision_mask: def.collision_mask,
             ..def.clone()
@@ -249,6 +268,8 @@ fn static_meshes(b: &PlanBody, def: &BodyDef, world: &mut World, made: &mut Made
             name: None,
             kind: BodyKind::Static,
             friction: g.friction,
+            torsional_friction: g.torsional,
+            rolling_resistance: 0.0,
             ..def.clone()
         };
         let id = world

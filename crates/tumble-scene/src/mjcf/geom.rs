@@ -30,6 +30,10 @@ pub(crate) struct Geom {
     pub conaffinity: u32,
     /// The sliding friction coefficient (the first of MuJoCo's three).
     pub friction: Real,
+    /// The torsional (m) and rolling (m) friction coefficients, the second and third,
+    /// where the geom's `condim` reaches them (4 and 6), else 0.
+    pub torsional: Real,
+    pub rolling: Real,
     pub rgb: Option<[u8; 3]>,
     /// A colliding mesh geom of a static body: its triangles in the geom's frame.
     pub triangles: Option<super::mesh::Triangles>,
@@ -39,8 +43,7 @@ pub(crate) struct Geom {
 
 /// Geom attributes with physics the import does not map (contact softness, margins,
 /// fluid forces), warned about when a geom or its class sets them.
-const UNREAD: [&str; 8] = [
-    "condim",
+const UNREAD: [&str; 7] = [
     "solref",
     "solimp",
     "solmix",
@@ -78,8 +81,9 @@ pub(crate) fn geom(
             warn.add(v.elem, &format!("geom {key}: not read"));
         }
     }
+    let f = friction(v, warn)?;
     if kind == "mesh" {
-        return mesh_geom(v, c, target).map(Some);
+        return mesh_geom(v, c, target, f).map(Some);
     }
     if v.get("mesh").is_some() {
         warn.add(
@@ -126,7 +130,9 @@ pub(crate) fn geom(
         mass,
         contype: v.bits("contype", 1)?,
         conaffinity: v.bits("conaffinity", 1)?,
-        friction: friction(v)?,
+        friction: f.slide,
+        torsional: f.torsional,
+        rolling: f.rolling,
         rgb: rgb(v)?,
         triangles: None,
         label: v.elem.label(),
@@ -135,7 +141,7 @@ pub(crate) fn geom(
 
 /// A mesh geom: its frame moved to the mesh's centre of mass (MuJoCo's `geom_pos`); the
 /// mesh's convex hull on a moving body, its triangles on a static one.
-fn mesh_geom(v: &View<'_>, c: &Compiler, target: Target<'_>) -> Result<Geom> {
+fn mesh_geom(v: &View<'_>, c: &Compiler, target: Target<'_>, f: Friction) -> Result<Geom> {
     let name = v
         .get("mesh")
         .ok_or_else(|| v.err("mesh", "missing on a mesh geom"))?;
@@ -158,7 +164,9 @@ fn mesh_geom(v: &View<'_>, c: &Compiler, target: Target<'_>) -> Result<Geom> {
         mass,
         contype,
         conaffinity,
-        friction: friction(v)?,
+        friction: f.slide,
+        torsional: f.torsional,
+        rolling: f.rolling,
         rgb: rgb(v)?,
         triangles,
         label: v.elem.label(),
@@ -268,12 +276,59 @@ fn geom_mass(v: &View<'_>, unit: &MassProperties) -> Result<MassProperties> {
     })
 }
 
-fn friction(v: &View<'_>) -> Result<Real> {
-    let f = v.reals("friction", &[1, 2, 3])?;
-    match f {
-        Some(f) if f[0] < 0.0 => Err(v.err("friction", format!("must be >= 0, got {}", f[0]))),
-        Some(f) => Ok(f[0]),
-        None => Ok(1.0),
+/// A geom's friction as its `condim` makes it act (see [`friction`]).
+struct Friction {
+    slide: Real,
+    torsional: Real,
+    rolling: Real,
+}
+
+/// MuJoCo's friction triple (sliding; torsional and rolling, in metres: the torque's cap
+/// per newton of normal force), `1 0.005 0.0001` where not given, and the part of it the
+/// geom's `condim` switches on: torsional from 4, rolling at 6. A pair's coefficients
+/// are each the larger of its two geoms' (MuJoCo's rule at equal priority, and Tumble's
+/// for torsional friction and rolling resistance). `condim 1` (frictionless) holds only
+/// between two such geoms in MuJoCo, which one body's friction cannot say: warned.
+fn friction(v: &View<'_>, warn: &mut Warnings) -> Result<Friction> {
+    let given = v.reals("friction", &[1, 2, 3])?.unwrap_or_default();
+    let mut f = [1.0, 0.005, 0.0001];
+    for (k, x) in given.into_iter().enumerate() {
+        if !x.is_finite() || x < 0.0 {
+            return Err(v.err("friction", format!("must be finite and >= 0, got {x}")));
+        }
+        f[k] = x;
+    }
+    let condim = v.bits("condim", 3)?;
+    if !matches!(condim, 1 | 3 | 4 | 6) {
+        return Err(v.err("condim", format!("must be 1, 3, 4 or 6, got {condim}")));
+    }
+    if condim == 1 {
+        warn.add(
+            v.elem,
+            "geom condim 1 (frictionless): not read, friction kept",
+        );
+    }
+    Ok(Friction {
+        slide: f[0],
+        torsional: if condim >= 4 { f[1] } else { 0.0 },
+        rolling: if condim == 6 { f[2] } else { 0.0 },
+    })
+}
+
+/// The radius a geom rolls on, which turns MuJoCo's rolling friction (a length) into
+/// Tumble's dimensionless rolling resistance μ_r (a torque of at most μ_r r N, r the
+/// distance from the centre of mass to the contact plane): a round geom's radius, a box's
+/// or hull's smallest half-width. Exact for a ball, MuJoCo's usual roller.
+pub(crate) fn rolling_radius(shape: &Shape) -> Option<Real> {
+    match shape {
+        Shape::Sphere { radius } | Shape::Capsule { radius, .. } => Some(*radius),
+        Shape::Cylinder { radius, .. } => Some(*radius),
+        Shape::Box { half_extents } => Some(half_extents.min_element()),
+        Shape::ConvexHull(_) => {
+            let b = shape.aabb(&tumble::Pose::IDENTITY);
+            Some((0.5 * (b.max - b.min)).min_element())
+        }
+        _ => None,
     }
 }
 

@@ -26,6 +26,10 @@
 //!   the same law); position (kp) and velocity (kv) actuators at zero control add their
 //!   gains to it; motors at zero control exert nothing; `armature` and `frictionloss`
 //!   cannot be expressed and are warned about;
+//! - `condim` 4 and 6 → the body's torsional friction (MuJoCo's second coefficient, in
+//!   metres, as Tumble's) and rolling resistance (the third over the radius the geom
+//!   rolls on: Tumble's is dimensionless), the largest of its geoms'; `condim` 1 is
+//!   warned about (frictionless only between two such geoms in MuJoCo);
 //! - contype/conaffinity → collision group/mask (exact, see `build::filters`); parent and
 //!   child never collide; `<contact><exclude>` pairs are filtered out (the world's contact
 //!   filter, set when there are such pairs, replaces any filter set before).
