@@ -19,10 +19,10 @@
 //! and a grouped manifold's points are prepared straight into their lanes, slot by slot:
 //! their scalar entries in `Points::hot` are not written at all. Copied there first and
 //! then into the lanes, the points were written twice and read once more, and the copy
-//! alone was 11 % of the pyramid's step. The scalar points get the impulses back before
-//! the end-of-step passes ([`ContactLanes::write_back`]), and the whole points when a
-//! bounce or an overlap pass will read them. Colour 63 and a colour's leftover single
-//! constraint stay on the scalar path, in their place in the order.
+//! alone was 11 % of the pyramid's step. The contacts take their impulses from the lanes
+//! ([`ContactLanes::solved`]); the points are copied back whole only when a bounce or an
+//! overlap pass will read them ([`ContactLanes::write_back`]). Colour 63 and a colour's
+//! leftover single constraint stay on the scalar path, in their place in the order.
 
 use std::ops::Range;
 
@@ -401,7 +401,8 @@ impl LaneWriter<'_> {
                 to = to.max(slot0 + count(k));
             }
         }
-        let span = if from < to { from..to } else { 0..0 };
+        // A manifold without points (a hook may empty one) still places the span.
+        let span = if from <= to { from..to } else { 0..0 };
         // SAFETY: within the range's own groups' slots (see above).
         let (slots, sums) =
             unsafe { (self.slots.part(span.clone()), self.sums.part(span.clone())) };
