@@ -695,7 +695,8 @@ impl Solver {
             let out = (&mut hot[..], &mut cold[..]);
             with.piece(0..n, (&mut self.constraints, &mut lanes), out, angular);
         } else {
-            prepare_in_pieces(&with, (&mut self.constraints, hot, cold), &writer, self.par);
+            let out = (&mut self.constraints[..], &mut hot[..], &mut cold[..]);
+            prepare_in_pieces(&with, out, &writer, (pieces, self.par.threads));
         }
         // The points that overlap too deeply, in order (each touches its own
         // constraint's points).
@@ -740,12 +741,10 @@ impl Solver {
             let at = (mp.separation, start_velocity);
             // A grouped point lives in its lane.
             let lanes = &mut self.points.lanes;
-            let deep = match lanes.point(k, j) {
-                Some(p) => overlap::Deep::find((k, first + j), at, &p, allow),
-                None => overlap::Deep::find((k, first + j), at, &self.points.hot[first + j], allow),
-            };
-            if let Some(deep) = deep {
-                match lanes.point(k, j) {
+            let grouped = lanes.point(k, j);
+            let p = grouped.as_ref().unwrap_or(&self.points.hot[first + j]);
+            if let Some(deep) = overlap::Deep::find((k, first + j), at, p, allow) {
+                match grouped {
                     Some(_) => lanes.set_separation((k, j), -deep.depth),
                     None => self.points.hot[first + j].separation = -deep.depth,
                 }
@@ -1077,10 +1076,9 @@ fn prepare_in_pieces(
     with: &PrepareWith<'_>,
     (constraints, hot, cold): (&mut [ContactConstraint], &mut [Point], &mut [PointCold]),
     writer: &contact_wide::LaneWriter<'_>,
-    par: Par,
+    (pieces, threads): (usize, usize),
 ) {
     let n = with.order.len();
-    let pieces = par.pieces(n, CONSTRAINTS_A_PIECE);
     let size = n.div_ceil(pieces).max(1);
     let count = n.div_ceil(size);
     let bounds: Vec<usize> = (0..=count)
@@ -1088,7 +1086,7 @@ fn prepare_in_pieces(
         .collect();
     let constraints = Parts::new(constraints);
     let (hot, cold) = (Parts::new(hot), Parts::new(cold));
-    crate::team::pieces(par.threads, count, &|i| {
+    crate::team::pieces(threads, count, &|i| {
         let range = bounds[i]..bounds[i + 1];
         if range.is_empty() {
             return;
