@@ -156,6 +156,21 @@ impl PyJoint {
         self.edit(|w, id| w.set_joint_break_force(id, force))
     }
 
+    /// A hinge's or slider's armature, the coordinate's rotor inertia (kg m² or kg);
+    /// settable (finite, >= 0; only hinges and sliders take one above 0).
+    #[getter]
+    fn armature(&self) -> PyResult<f64> {
+        self.read(|j| wide(j.def().armature))
+    }
+
+    #[setter]
+    fn set_armature(&self, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        let a: f64 = value
+            .extract()
+            .map_err(|_| wrong_type("armature", "a number", value))?;
+        self.edit(|w, id| w.set_joint_armature(id, crate::convert::real(a)))
+    }
+
     /// The joint's coordinate, of `body` relative to `other`, zero at creation: hinge
     /// angle (rad, in (-pi, pi]), slider offset (m), distance (m); a ball or fixed joint's
     /// rotation vector (rad, in `other`'s frame) as a 3-tuple. Settable (not on fixed

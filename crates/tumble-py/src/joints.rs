@@ -356,10 +356,11 @@ impl PyWorld {
     /// [lo, hi] (rad); hinge and slider `limits` [lo, hi] (rad or m), `motor`
     /// (tumble.Motor), `spring` (tumble.JointSpring), `servo` (tumble.Servo); distance `length`, `min`, `max` (m)
     /// and `spring`. `collide_connected` lets the two bodies still collide; `break_force`
-    /// (N) breaks the joint when exceeded.
+    /// (N) breaks the joint when exceeded; `armature` (hinge kg m², slider kg) is the
+    /// coordinate's rotor inertia, MuJoCo's armature.
     #[pyo3(signature = (kind, body, other = None, *, anchor = None, axis = None,
         other_anchor = None, other_axis = None, name = None, collide_connected = false,
-        break_force = None, **options))]
+        break_force = None, armature = 0.0, **options))]
     #[allow(clippy::too_many_arguments)]
     fn add_joint<'py>(
         slf: &Bound<'py, Self>,
@@ -373,6 +374,7 @@ impl PyWorld {
         name: Option<String>,
         collide_connected: bool,
         break_force: Option<f64>,
+        armature: f64,
         options: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyJoint>> {
         let kind = kind_of(&kind, options)?;
@@ -404,6 +406,7 @@ impl PyWorld {
                 other_axis,
                 collide_connected,
                 break_force: break_force.map(real),
+                armature: real(armature),
             };
             g.world.create_joint(&def).map_err(engine)?
         };

@@ -22,7 +22,7 @@ pub const JOINT_TYPES: [&str; JOINT_KINDS.len()] = {
     names
 };
 
-const COMMON_KEYS: [&str; 10] = [
+const COMMON_KEYS: [&str; 11] = [
     "type",
     "name",
     "body",
@@ -33,6 +33,7 @@ const COMMON_KEYS: [&str; 10] = [
     "other_axis",
     "collide_connected",
     "break_force",
+    "armature",
 ];
 
 /// Reads one joint, resolving body names in `world`. Numbers are checked by the engine
@@ -83,6 +84,7 @@ pub(crate) fn joint(node: &Node<'_>, world: &World) -> Result<JointDef> {
         other_axis,
         collide_connected: obj.bool("collide_connected")?.unwrap_or(false),
         break_force: obj.real("break_force")?,
+        armature: obj.real("armature")?.unwrap_or(0.0),
     })
 }
 

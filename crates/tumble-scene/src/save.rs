@@ -372,6 +372,9 @@ fn joint(j: &Joint, refs: &References) -> String {
     if let Some(b) = def.break_force {
         f.add("break_force", num(b));
     }
+    if def.armature != 0.0 {
+        f.add("armature", num(def.armature));
+    }
     let options = def.kind.options();
     let limit = spec.motor_limit_key();
     for option in spec.options.iter().map(|o| o.option) {

@@ -395,8 +395,8 @@ class Servo:
 JointCoordinate = Union[float, Tuple[float, float, float]]
 
 class Joint:
-    """A handle on a joint. `motor`, `servo`, `limits`, `spring`, `enabled`, `break_force`
-    and `position` are settable while the world runs (checked as `add_joint` checks them;
+    """A handle on a joint. `motor`, `servo`, `limits`, `spring`, `enabled`, `break_force`,
+    `armature` and `position` are settable while the world runs (checked as `add_joint` checks them;
     a refused value changes nothing; both bodies are woken)."""
 
     @property
@@ -448,6 +448,11 @@ class Joint:
         """Reaction force (N) beyond which the joint breaks, or None."""
     @break_force.setter
     def break_force(self, value: Optional[float]) -> None: ...
+    @property
+    def armature(self) -> float:
+        """A hinge's or slider's armature, the coordinate's rotor inertia (kg m² or kg)."""
+    @armature.setter
+    def armature(self, value: float) -> None: ...
     @property
     def position(self) -> JointCoordinate:
         """Hinge angle (rad, in (-pi, pi]), slider offset or distance (m); a ball or fixed
@@ -629,6 +634,7 @@ class World:
         name: Optional[str] = None,
         collide_connected: bool = False,
         break_force: Optional[float] = None,
+        armature: float = 0.0,
         # The options each kind takes (tumble::joint::JOINT_KINDS); another kind's is a
         # TypeError, None counts as left out.
         cone: Optional[float] = None,

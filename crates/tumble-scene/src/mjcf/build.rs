@@ -49,6 +49,8 @@ pub(crate) struct PlanJoint {
     pub reference: Real,
     /// Passive spring k, its target (Tumble coordinate), damper c.
     pub spring: (Real, Real, Real),
+    /// The coordinate's armature (hinge kg m², slide kg; 0 for a ball joint).
+    pub armature: Real,
 }
 
 /// Everything read from the file, checked, before the world is touched.
@@ -468,6 +470,9 @@ fn add_joints(
         if views.len() > 1 {
             return Err(free.elem.err("a free joint must be its body's only joint"));
         }
+        if non_negative(free, "armature")? > 0.0 {
+            ctx.warn.add(free.elem, "free joint armature: not applied");
+        }
         let name = joint_name(ctx, free.elem);
         ctx.free.push((name, body));
         if ctx.bodies[parent].dynamic {
@@ -541,6 +546,7 @@ fn joint(ctx: &mut Ctx<'_>, v: &View<'_>, body: usize, other: usize) -> Result<P
     let stiffness = non_negative(v, "stiffness")? * passive;
     let damping = non_negative(v, "damping")? * passive;
     let springref = unit(v.real("springref")?.unwrap_or(0.0));
+    let mut armature = non_negative(v, "armature")?;
     warn_unread_joint(ctx, v)?;
     let def = match kind.as_str() {
         "hinge" => JointKind::Hinge {
@@ -560,6 +566,10 @@ fn joint(ctx: &mut Ctx<'_>, v: &View<'_>, body: usize, other: usize) -> Result<P
                 ctx.warn
                     .add(v.elem, "ball joint stiffness and damping: not applied");
             }
+            if armature > 0.0 {
+                ctx.warn.add(v.elem, "ball joint armature: not applied");
+                armature = 0.0;
+            }
             JointKind::Ball {
                 cone: range.map(|r| r[1] + reference),
                 twist: None,
@@ -577,6 +587,7 @@ fn joint(ctx: &mut Ctx<'_>, v: &View<'_>, body: usize, other: usize) -> Result<P
         axis,
         reference,
         spring: (stiffness, springref - reference, damping),
+        armature,
     })
 }
 
@@ -587,13 +598,11 @@ fn warn_unread_joint(ctx: &mut Ctx<'_>, v: &View<'_>) -> Result<()> {
             ctx.warn.add(v.elem, &format!("joint {key}: not read"));
         }
     }
-    for key in ["armature", "frictionloss"] {
-        if non_negative(v, key)? > 0.0 {
-            ctx.warn.add(
-                v.elem,
-                &format!("joint {key}: cannot be expressed, not applied"),
-            );
-        }
+    if non_negative(v, "frictionloss")? > 0.0 {
+        ctx.warn.add(
+            v.elem,
+            "joint frictionloss: cannot be expressed, not applied",
+        );
     }
     Ok(())
 }

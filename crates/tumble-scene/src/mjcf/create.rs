@@ -330,6 +330,7 @@ fn joint_def(
         other_axis: inv * axis_w,
         collide_connected: false,
         break_force: None,
+        armature: j.armature,
     })
 }
 

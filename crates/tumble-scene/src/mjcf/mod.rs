@@ -24,8 +24,10 @@
 //!   bodies, one per extra joint (MuJoCo's chain of joints in one body);
 //! - `stiffness`, `springref` and `damping` → the joint's servo (τ = −k (q − q_ref) − c q̇,
 //!   the same law); position (kp) and velocity (kv) actuators at zero control add their
-//!   gains to it; motors at zero control exert nothing; `armature` and `frictionloss`
-//!   cannot be expressed and are warned about;
+//!   gains to it; motors at zero control exert nothing; a hinge's or slide's `armature`
+//!   → the joint's armature (`JointDef::armature`, the same generalised inertia; a ball's
+//!   or free joint's is warned about); `frictionloss` cannot be expressed and is warned
+//!   about;
 //! - `condim` 4 and 6 → the body's torsional friction (MuJoCo's second coefficient, in
 //!   metres, as Tumble's) and rolling resistance (the third over the radius the geom
 //!   rolls on: Tumble's is dimensionless), the largest of its geoms'; `condim` 1 is

@@ -680,6 +680,7 @@ fn create_all(
             other_axis: j.other_axis,
             collide_connected: false,
             break_force: None,
+            armature: 0.0,
         };
         let id = world
             .create_joint(&def)

@@ -507,7 +507,7 @@ fn includes_and_their_defaults_are_read() {
 
 #[test]
 fn unsupported_parts_are_warned_once_with_their_line() {
-    let text = "<mujoco>\n<worldbody>\n<body name=\"a\"><joint armature=\"0.1\"/>\n<geom size=\"0.1\"/>\n<geom type=\"hfield\" hfield=\"m\"/>\n<geom type=\"hfield\" hfield=\"n\"/>\n</body>\n</worldbody>\n<tendon/>\n</mujoco>";
+    let text = "<mujoco>\n<worldbody>\n<body name=\"a\"><joint frictionloss=\"0.1\"/>\n<geom size=\"0.1\"/>\n<geom type=\"hfield\" hfield=\"m\"/>\n<geom type=\"hfield\" hfield=\"n\"/>\n</body>\n</worldbody>\n<tendon/>\n</mujoco>";
     let mut world = z_up();
     let m = mjcf::load(write("warn.xml", text), &mut world, &MjcfOptions::default()).unwrap();
     let lines: Vec<String> = m.warnings.iter().map(|w| w.to_string()).collect();
@@ -518,7 +518,7 @@ fn unsupported_parts_are_warned_once_with_their_line() {
     assert!(
         lines
             .iter()
-            .any(|l| l.starts_with("warn.xml:3: <joint>: joint armature")),
+            .any(|l| l.starts_with("warn.xml:3: <joint>: joint frictionloss")),
         "{lines:?}"
     );
     assert!(
@@ -526,6 +526,31 @@ fn unsupported_parts_are_warned_once_with_their_line() {
         "{lines:?}"
     );
     assert_eq!(lines.len(), 3, "{lines:?}");
+}
+
+#[test]
+fn armature_is_read_from_hinges_slides_and_defaults_and_warned_on_balls() {
+    let text = "<mujoco>\n<default><joint armature=\"0.25\"/></default>\n<worldbody>\n<body name=\"a\"><joint name=\"h\" type=\"hinge\"/><geom size=\"0.1\"/>\n<body name=\"b\" pos=\"0 0 -1\"><joint name=\"s\" type=\"slide\" armature=\"2\"/><geom size=\"0.1\"/>\n<body name=\"c\" pos=\"0 0 -1\"><joint name=\"ball\" type=\"ball\"/><geom size=\"0.1\"/>\n</body></body></body>\n</worldbody>\n</mujoco>";
+    let mut world = z_up();
+    let m = mjcf::load(
+        write("armature.xml", text),
+        &mut world,
+        &MjcfOptions::default(),
+    )
+    .unwrap();
+    let armature = |name: &str| {
+        let id = m.joint(name).unwrap().id.unwrap();
+        world.joint(id).unwrap().def().armature
+    };
+    assert_eq!(
+        (armature("h"), armature("s"), armature("ball")),
+        (0.25, 2.0, 0.0)
+    );
+    let lines: Vec<String> = m.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(
+        lines,
+        ["armature.xml:6: <joint name=\"ball\">: ball joint armature: not applied"],
+    );
 }
 
 /// Every kind of bad file: one line, `file:line: <element>: what`, and the world as it

@@ -20,6 +20,7 @@ mod finite_state;
 mod force_callbacks;
 mod free_fall;
 mod heavy_loads;
+mod joint_armature;
 mod joint_chains;
 mod joint_control;
 mod joints;

@@ -150,6 +150,12 @@ pub struct JointDef {
     pub collide_connected: bool,
     /// Reaction force (N) beyond which the joint breaks; `None`: unbreakable.
     pub break_force: Option<Real>,
+    /// Armature (rotor inertia) of a hinge's or slider's coordinate: kg m² about a hinge's
+    /// axis, kg along a slider's (MuJoCo's `armature`, a geared motor's reflected rotor).
+    /// The coordinate's acceleration meets a generalised force −a q̈, acting equally and
+    /// oppositely on the two bodies, as if the joint's own mass matrix were larger by a.
+    /// Finite and ≥ 0; other kinds take none. Default 0: none, at no cost.
+    pub armature: Real,
 }
 
 impl JointDef {
@@ -167,6 +173,7 @@ impl JointDef {
             other_axis: Vec3::X,
             collide_connected: false,
             break_force: None,
+            armature: 0.0,
         }
     }
 }
@@ -213,6 +220,12 @@ pub(crate) struct JointImpulses {
     pub servo: Real,
     /// Rigid distance row.
     pub axial: Real,
+    /// What the coordinate's armature (see [`JointDef::armature`]) pushed on the bodies
+    /// along the free row in the last substep; warm started with the rest.
+    pub armature: Real,
+    /// How far the armature's flywheel (see `solver/joint_armature.rs`) ran ahead of the
+    /// coordinate's rate at the end of the last substep: the coupling's unsolved rest.
+    pub flywheel_lag: Real,
 }
 
 impl Joint {
@@ -259,6 +272,19 @@ impl Joint {
     }
 }
 
+/// Checks an armature for a joint of `kind`: finite, ≥ 0, and on a hinge or a slider.
+pub(crate) fn check_armature(armature: Real, kind: &JointKind) -> Result<()> {
+    check::non_negative("armature", armature)?;
+    let free = matches!(kind, JointKind::Hinge { .. } | JointKind::Slider { .. });
+    if armature > 0.0 && !free {
+        return Err(Error::invalid(
+            "armature",
+            "only hinge and slider joints take one",
+        ));
+    }
+    Ok(())
+}
+
 /// Checks a definition's numbers; field paths are relative to the def (`limits`, `axis`).
 pub(crate) fn validate(def: &JointDef) -> Result<()> {
     check::vec3_at_most("anchor", def.anchor, MAX_COORDINATE, "m")?;
@@ -272,6 +298,7 @@ pub(crate) fn validate(def: &JointDef) -> Result<()> {
     if let Some(f) = def.break_force {
         check::positive("break_force", f)?;
     }
+    check_armature(def.armature, &def.kind)?;
     if def.other == Some(def.body) {
         return Err(Error::invalid("other", "must differ from body"));
     }
@@ -401,7 +428,8 @@ crate::codec::codec_struct!(JointDef {
     other_anchor,
     other_axis,
     collide_connected,
-    break_force
+    break_force,
+    armature
 });
 crate::codec::codec_struct!(Joint {
     def,
@@ -425,7 +453,9 @@ crate::codec::codec_struct!(JointImpulses {
     motor,
     spring,
     servo,
-    axial
+    axial,
+    armature,
+    flywheel_lag
 });
 
 impl crate::codec::Code for JointKind {

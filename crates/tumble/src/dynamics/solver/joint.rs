@@ -31,6 +31,8 @@
 //! current poses every pass: a joint turns far within a step (a pendulum's anchor swings),
 //! unlike a contact.
 
+#[path = "joint_armature.rs"]
+mod armature;
 #[path = "joint_block.rs"]
 mod block;
 #[path = "joint_chain.rs"]
@@ -227,6 +229,10 @@ pub(crate) struct JointConstraint {
     /// The chain of joints through light bodies this joint belongs to (see
     /// `joint_chain.rs`), whose block solves its hard rows instead of its own.
     pub chain: Option<usize>,
+    /// The coordinate's armature (see `JointDef::armature`; 0: none) and its flywheel's
+    /// rate in the substep (see `joint_armature.rs`).
+    armature: Real,
+    flywheel: Real,
 }
 
 /// Where the geometry of a joint stands at the bodies' current poses. Poses change only
@@ -288,6 +294,8 @@ impl JointConstraint {
             plain_ball,
             block: None,
             chain: None,
+            armature: joint.def.armature,
+            flywheel: 0.0,
         }
     }
 

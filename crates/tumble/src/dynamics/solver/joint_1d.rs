@@ -81,7 +81,7 @@ impl Line {
 
     /// J v, plus the offset when there is one (a +0 added to a −0 would change recorded
     /// results).
-    fn velocity(&self, a: &BodyState, b: &BodyState) -> Real {
+    pub fn velocity(&self, a: &BodyState, b: &BodyState) -> Real {
         let v = self.row.velocity(a, b);
         if self.offset != 0.0 {
             v + self.offset
@@ -92,15 +92,12 @@ impl Line {
 }
 
 /// The impulse along the free coordinate's row: limits (the upper one's row is negated),
-/// motor, spring and rod.
+/// motor, spring, rod and armature.
 pub(super) fn free_impulse(imp: &JointImpulses) -> Real {
     let sum = imp.lower - imp.upper + imp.motor + imp.spring + imp.axial;
     // Added only when there is one: a +0 added to a −0 sum would change recorded results.
-    if imp.servo != 0.0 {
-        sum + imp.servo
-    } else {
-        sum
-    }
+    let add = |sum: Real, x: Real| if x != 0.0 { sum + x } else { sum };
+    add(add(sum, imp.servo), imp.armature)
 }
 
 /// What acts on a joint's free coordinate, from its options: the limits (`limits`, a

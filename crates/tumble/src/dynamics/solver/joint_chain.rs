@@ -157,6 +157,20 @@ impl ChainBlock {
 /// Finds the chains among `joints` (the solver's list, their `chain` unset), marks their
 /// members, and returns them.
 pub(crate) fn find_chains(joints: &mut [JointConstraint], sims: &[BodySim]) -> Vec<Chain> {
+    let mut chains = light_chains(joints, sims);
+    // A joint with an armature needs its free row's mass with its hard rows holding (see
+    // `joint_armature.rs`): out of a chain, it is a chain of its own.
+    for (i, j) in joints.iter_mut().enumerate() {
+        if j.has_armature() && j.chain.is_none() && j.has_block() && j.cone.is_none() {
+            j.chain = Some(chains.len());
+            chains.push(Chain { joints: vec![i] });
+        }
+    }
+    chains
+}
+
+/// The chains of joints through light bodies (see the module's header).
+fn light_chains(joints: &mut [JointConstraint], sims: &[BodySim]) -> Vec<Chain> {
     // A chain has two joints at least; without, skip the per-body lists (every step).
     if joints.len() < 2 {
         return Vec::new();
@@ -337,7 +351,11 @@ impl Chain {
         }
         let k = Eliminated::new(k, n);
         let mut free = Vec::new();
-        for &i in self.joints.iter().filter(|&&i| !joints[i].drive.is_idle()) {
+        for &i in self
+            .joints
+            .iter()
+            .filter(|&&i| joints[i].acts_on_free_row())
+        {
             let (c, fr) = (&joints[i], &frames[i]);
             let Some((row, _)) = c.free_row(fr) else {
                 continue;
@@ -380,7 +398,7 @@ impl Chain {
         pass: impl Fn(&JointConstraint) -> &'p JointPass,
         (blocks, cache): (&mut [Option<super::Block>], &mut Option<ChainBlock>),
     ) {
-        if joints[i].drive.is_idle() {
+        if !joints[i].acts_on_free_row() {
             return;
         }
         let chain = cache.get_or_insert_with(|| self.block(joints, frames, blocks));
@@ -398,12 +416,24 @@ impl Chain {
             },
             None => Line::own(row, fr),
         };
-        let p = pass(&joints[i]);
-        for part in joints[i].drive.parts() {
-            let delta = joints[i].solve_free_part(&part, (line, coordinate), (fr, p), states);
+        let push = |delta: Real, joints: &mut [JointConstraint], states: &mut [BodyState]| {
             if let Some(free) = free.filter(|_| delta != 0.0) {
                 self.carry((chain, free, delta), joints, states);
             }
+        };
+        let armature = joints[i].has_armature();
+        if armature {
+            let mu = joints[i].couple_armature(line, fr, states);
+            push(mu, joints, states);
+        }
+        let p = pass(&joints[i]);
+        let folded = joints[i].with_armature(line);
+        for part in joints[i].drive.parts() {
+            let mut delta = joints[i].solve_free_part(&part, (folded, coordinate), (fr, p), states);
+            if armature && delta != 0.0 {
+                delta += joints[i].fold_armature((delta, line.mass), (row, fr), states);
+            }
+            push(delta, joints, states);
         }
     }
 

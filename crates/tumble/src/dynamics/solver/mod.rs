@@ -101,6 +101,8 @@ pub(crate) struct Solver {
     /// `joint_blocks`).
     chains: Vec<Chain>,
     chain_blocks: Vec<Option<ChainBlock>>,
+    /// Whether a joint has an armature (see `joint_armature.rs`).
+    armatures: bool,
     /// The joint list's colours and serial rests (see `joint_colours.rs`), and scratch.
     joint_runs: Vec<JointRun>,
     joint_used: Vec<u64>,
@@ -267,6 +269,7 @@ impl Solver {
     ) {
         let (h, world_bodies) = (input.time.h, input.system.bodies);
         let t = input.time.t + i as Real * h;
+        self.begin_armatures(&mut bodies.states);
         // After a split kick's second half the forces are those of this substep's start.
         self.kick(bodies, input.system, t, h, (i == 0 || !any_split, false));
         if self.fine > 1 {
@@ -294,7 +297,29 @@ impl Solver {
         if iterations == 0 {
             ContactConstraint::add_to_totals(&self.points.hot, &mut self.points.cold);
         }
+        self.end_armatures(&mut bodies.states);
         self.add_joint_totals();
+    }
+
+    /// Starts the substep's armature flywheels (see `joint_armature.rs`) at the rates
+    /// before the kick.
+    fn begin_armatures(&mut self, states: &mut [BodyState]) {
+        if !self.armatures {
+            return;
+        }
+        for (j, fr) in self.joints.iter_mut().zip(&self.joint_frames) {
+            j.begin_armature(fr, states);
+        }
+    }
+
+    /// Keeps each flywheel's lag behind its coordinate for the next substep.
+    fn end_armatures(&mut self, states: &mut [BodyState]) {
+        if !self.armatures {
+            return;
+        }
+        for (j, fr) in self.joints.iter_mut().zip(&self.joint_frames) {
+            j.end_armature(fr, states);
+        }
     }
 
     /// Adds each joint's substep impulses to its totals, in pieces on the step's team.
@@ -821,6 +846,7 @@ impl Solver {
         self.joint_blocks.clear();
         self.joint_blocks.resize(blocks, None);
         self.chains = find_chains(&mut self.joints, &solver_bodies.sims);
+        self.armatures = self.joints.iter().any(|j| j.has_armature());
         let (n, heavy) = (self.joints.len(), self.heavy_joints);
         self.joint_runs = joint_colours::order(
             &mut self.joints,

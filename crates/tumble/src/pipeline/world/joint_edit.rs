@@ -117,6 +117,16 @@ impl World {
         Ok(())
     }
 
+    /// Sets a hinge's or slider's armature (see [`joint::JointDef::armature`]); refused unless
+    /// finite and ≥ 0 (`armature: must be >= 0`), or > 0 on another kind of joint.
+    pub fn set_joint_armature(&mut self, id: JointId, armature: Real) -> Result<()> {
+        let k = self.joints.handles.dense(id).ok_or_else(|| unknown(id))?;
+        joint::check_armature(armature, &self.joints.list[k].def.kind)?;
+        self.joints.list[k].def.armature = armature;
+        self.wake_joint(k);
+        Ok(())
+    }
+
     /// Wakes the bodies of joint `k` (dense) and what touches them.
     pub(super) fn wake_joint(&mut self, k: usize) {
         let def = &self.joints.list[k].def;
