@@ -62,6 +62,22 @@ pub const DT: f64 = 1.0 / 60.0;
 pub const GRAVITY_Y: f64 = -9.81;
 /// Substeps per step in both engines.
 pub const SUBSTEPS: u32 = 4;
+
+/// Rapier's substeps when `compare --rapier-substeps N` asks for other than [`SUBSTEPS`]:
+/// Tumble solves a tall stack's island at up to eight times its substeps
+/// (`dynamics/solver/stacks.rs`), so the large pyramid's time is also worth comparing
+/// with rapier's at the substeps that hold it as still.
+static RAPIER_SUBSTEPS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(SUBSTEPS);
+
+/// Sets rapier's substeps for the worlds built after (see [`RAPIER_SUBSTEPS`]).
+pub fn set_rapier_substeps(n: u32) {
+    RAPIER_SUBSTEPS.store(n.max(1), std::sync::atomic::Ordering::Relaxed);
+}
+
+/// Rapier's substeps (see [`RAPIER_SUBSTEPS`]).
+pub fn rapier_substeps() -> u32 {
+    RAPIER_SUBSTEPS.load(std::sync::atomic::Ordering::Relaxed)
+}
 /// Friction coefficient of every body.
 pub const FRICTION: f64 = 0.5;
 /// Density of every body (kg/m³).
@@ -533,12 +549,13 @@ macro_rules! rapier_engine {
                 [p.x as f64, p.y as f64, p.z as f64]
             }
 
-            /// The integration parameters of every scene: dt = 1/60 s and 4 substeps, each
-            /// one biased solve and one relax (stabilisation) pass.
+            /// The integration parameters of every scene: dt = 1/60 s and 4 substeps (unless
+            /// `--rapier-substeps` says otherwise), each one biased solve and one relax
+            /// (stabilisation) pass.
             pub fn integration_parameters() -> IntegrationParameters {
                 IntegrationParameters {
                     dt: super::DT as Real,
-                    num_solver_iterations: super::SUBSTEPS as usize,
+                    num_solver_iterations: super::rapier_substeps() as usize,
                     num_internal_pgs_iterations: 1,
                     num_internal_stabilization_iterations: 1,
                     ..Default::default()

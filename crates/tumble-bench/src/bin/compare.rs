@@ -31,7 +31,7 @@ use tumble_bench::{median, pyramid, rapier_f32, rapier_f64, tumble_engine, Scene
 
 const USAGE: &str =
     "usage: compare [--scene NAME|all|scale] [--scale] [--threads N] [--repeats N] \
-     [--no-other-precision]
+     [--no-other-precision] [--rapier-substeps N]
 
   --scene S              run one scene: pyramid, rain, joints, large_pyramid, many_pyramids,
                          joint_grid_large, rain_large; or all (the three small ones, the
@@ -39,7 +39,9 @@ const USAGE: &str =
   --scale                the same as --scene scale
   --threads N            threads for Tumble and for rapier alike (default: TUMBLE_THREADS, else 1)
   --repeats N            runs per engine and scene, interleaved; medians are printed (default 3)
-  --no-other-precision   skip rapier at the precision Tumble was not built with";
+  --no-other-precision   skip rapier at the precision Tumble was not built with
+  --rapier-substeps N    rapier's substeps (default 4, Tumble's): to time it at the
+                         substeps that hold a tall stack as still as Tumble's finer ones";
 
 /// Untimed pyramid steps each engine takes before the first measurement.
 const WARMUP_STEPS: usize = 30;
@@ -103,6 +105,10 @@ fn parse(args: &[String]) -> Result<Options, String> {
             }
             "--repeats" => o.repeats = count("--repeats", it.next())?,
             "--no-other-precision" => o.other_precision = false,
+            "--rapier-substeps" => {
+                let n = count("--rapier-substeps", it.next())?;
+                tumble_bench::set_rapier_substeps(n.min(1024) as u32);
+            }
             "-h" | "--help" => return Err(String::new()),
             other => return Err(format!("unknown argument '{other}'")),
         }
@@ -187,12 +193,13 @@ fn print_header(options: &Options) {
         tumble_bench::rayon_pool(options.threads).install(rayon::current_num_threads);
     println!(
         "rapier3d {}, threads: Tumble {} (WorldDef::threads), rapier {} (rayon::current_num_threads() \
-         in the pool its steps run in); dt = 1/60 s, {} substeps; {} run(s) per engine; \
-         ms/step = median over runs of each run's mean (and of its median step)",
+         in the pool its steps run in); dt = 1/60 s, {} substeps (rapier {}); {} run(s) per \
+         engine; ms/step = median over runs of each run's mean (and of its median step)",
         rapier3d::VERSION,
         options.threads,
         rapier_threads,
         tumble_bench::SUBSTEPS,
+        tumble_bench::rapier_substeps(),
         options.repeats
     );
     for scene in &options.scenes {
