@@ -96,7 +96,38 @@ pub struct Manifold {
     count: u8,
 }
 
+impl ContactPoint {
+    /// `ContactPoint::default()`, usable in constants.
+    const ZERO: ContactPoint = ContactPoint {
+        point_a: Vec3::ZERO,
+        point_b: Vec3::ZERO,
+        separation: 0.0,
+        feature: 0,
+        normal_impulse: 0.0,
+        tangent_impulse: [0.0; 2],
+        total_normal_impulse: 0.0,
+        total_tangent_impulse: Vec3::ZERO,
+        anchor_a: Vec3::ZERO,
+        anchor_b: Vec3::ZERO,
+        anchored: false,
+        sliding: false,
+    };
+}
+
 impl Manifold {
+    /// `Manifold::default()` as a constant, for `Contact::BLANK`: a contact filled in its
+    /// place in a list starts from it.
+    pub(crate) const EMPTY: Manifold = Manifold {
+        normal: Vec3::ZERO,
+        subshape_a: 0,
+        subshape_b: 0,
+        angular_impulse: Vec3::ZERO,
+        overlap: Overlap::New,
+        fine: 0,
+        points: [ContactPoint::ZERO; MAX_MANIFOLD_POINTS],
+        count: 0,
+    };
+
     /// An empty manifold with this normal.
     pub fn new(normal: Vec3) -> Manifold {
         Manifold {

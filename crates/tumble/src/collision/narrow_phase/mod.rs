@@ -88,6 +88,28 @@ pub fn collide(
     }
 }
 
+/// What [`collide`] finds for two convex solids (spheres, boxes, capsules, cylinders,
+/// hulls: `Convex::from_shape` takes both), which meet in one manifold at most: written
+/// into `out`, which must be empty (`Manifold::default()`), and whether it has points
+/// (`collide` would have appended it, else nothing); `false` with `out` untouched for
+/// other shapes. The contact cache builds such a pair's manifold in its place among the
+/// contacts (see `pipeline/contact_cache.rs`).
+pub(crate) fn collide_solids(
+    a: &Shape,
+    pose_a: &Pose,
+    b: &Shape,
+    pose_b: &Pose,
+    margin: Real,
+    out: &mut Manifold,
+) -> bool {
+    // `collide`'s path for the pair: neither is a compound nor static-only, so neither
+    // recursion nor swap, and its last arm with a convex B.
+    let (Some(ca), Some(cb)) = (Convex::from_shape(a), Convex::from_shape(b)) else {
+        return false;
+    };
+    convex_pair(&ca, pose_a, &cb, pose_b, margin, out) && !out.is_empty()
+}
+
 /// `collide` with the roles exchanged, its manifolds flipped back.
 fn collide_swapped(
     a: &Shape,
