@@ -300,3 +300,32 @@ fn a_snapshot_mid_swing_continues_bit_identically_with_armatures() {
         assert_eq!(w.state_hash(), resumed.state_hash());
     }
 }
+
+#[test]
+fn an_armature_set_to_zero_mid_fall_leaves_nothing_behind() {
+    // A slider falling with armature falls at m g / (m + a); set to 0 mid-fall, it falls
+    // at g from then on: the flywheel's warm-started push goes with it.
+    let mut w = awake(Vec3::new(0.0, -G, 0.0));
+    let body = w
+        .create_body(&BodyDef::default(), Shape::cuboid(Vec3::splat(0.1)))
+        .unwrap();
+    let mut joint = JointDef::new(
+        JointKind::Slider {
+            limits: None,
+            motor: None,
+            spring: None,
+            servo: None,
+        },
+        body,
+    );
+    (joint.axis, joint.other_axis) = (Vec3::Y, Vec3::Y);
+    joint.armature = 3.0;
+    let j = w.create_joint(&joint).unwrap();
+    let dt = 1.0 / 60.0;
+    run(&mut w, dt, 30);
+    w.set_joint_armature(j, 0.0).unwrap();
+    let v0 = w.body(body).unwrap().linear_velocity().y;
+    run(&mut w, dt, 30);
+    let g = (v0 - w.body(body).unwrap().linear_velocity().y) / (30.0 * dt);
+    assert!((g / G - 1.0).abs() < 1e-6, "falls at {g} m/s² after");
+}

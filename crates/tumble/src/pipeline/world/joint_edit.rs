@@ -122,7 +122,13 @@ impl World {
     pub fn set_joint_armature(&mut self, id: JointId, armature: Real) -> Result<()> {
         let k = self.joints.handles.dense(id).ok_or_else(|| unknown(id))?;
         joint::check_armature(armature, &self.joints.list[k].def.kind)?;
-        self.joints.list[k].def.armature = armature;
+        let j = &mut self.joints.list[k];
+        j.def.armature = armature;
+        if armature == 0.0 {
+            // The flywheel's push is warm started with the free row's impulses: without a
+            // flywheel left to answer it, it would push on for good.
+            (j.impulses.armature, j.impulses.flywheel_lag) = (0.0, 0.0);
+        }
         self.wake_joint(k);
         Ok(())
     }
