@@ -327,5 +327,8 @@ fn an_armature_set_to_zero_mid_fall_leaves_nothing_behind() {
     let v0 = w.body(body).unwrap().linear_velocity().y;
     run(&mut w, dt, 30);
     let g = (v0 - w.body(body).unwrap().linear_velocity().y) / (30.0 * dt);
-    assert!((g / G - 1.0).abs() < tol(1e-6, 1e-4), "falls at {g} m/s² after");
+    assert!(
+        (g / G - 1.0).abs() < tol(1e-6, 1e-4),
+        "falls at {g} m/s² after"
+    );
 }
