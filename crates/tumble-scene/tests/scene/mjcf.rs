@@ -31,8 +31,13 @@ fn z_up() -> World {
 }
 
 fn load(name: &str) -> (World, ImportedMjcf) {
+    load_at(model(name))
+}
+
+/// The file at `path` loaded into a fresh z-up world with the default options.
+fn load_at(path: PathBuf) -> (World, ImportedMjcf) {
     let mut world = z_up();
-    let m = mjcf::load(model(name), &mut world, &MjcfOptions::default()).unwrap();
+    let m = mjcf::load(path, &mut world, &MjcfOptions::default()).unwrap();
     (world, m)
 }
 
@@ -401,13 +406,7 @@ fn several_joints_in_one_body_chain_and_keep_their_coordinates() {
           <geom type="sphere" size="0.1"/>
         </body>
       </body></worldbody></mujoco>"#;
-    let mut world = z_up();
-    let m = mjcf::load(
-        write("chain.xml", text),
-        &mut world,
-        &MjcfOptions::default(),
-    )
-    .unwrap();
+    let (mut world, m) = load_at(write("chain.xml", text));
     // base, tip and two light bodies between them.
     assert_eq!(world.body_count(), 4);
     assert!(m
@@ -531,13 +530,7 @@ fn unsupported_parts_are_warned_once_with_their_line() {
 #[test]
 fn armature_is_read_from_hinges_slides_and_defaults_and_warned_on_balls() {
     let text = "<mujoco>\n<default><joint armature=\"0.25\"/></default>\n<worldbody>\n<body name=\"a\"><joint name=\"h\" type=\"hinge\"/><geom size=\"0.1\"/>\n<body name=\"b\" pos=\"0 0 -1\"><joint name=\"s\" type=\"slide\" armature=\"2\"/><geom size=\"0.1\"/>\n<body name=\"c\" pos=\"0 0 -1\"><joint name=\"ball\" type=\"ball\"/><geom size=\"0.1\"/>\n</body></body></body>\n</worldbody>\n</mujoco>";
-    let mut world = z_up();
-    let m = mjcf::load(
-        write("armature.xml", text),
-        &mut world,
-        &MjcfOptions::default(),
-    )
-    .unwrap();
+    let (world, m) = load_at(write("armature.xml", text));
     let armature = |name: &str| {
         let id = m.joint(name).unwrap().id.unwrap();
         world.joint(id).unwrap().def().armature

@@ -9,15 +9,6 @@ use tumble::prelude::*;
 
 const G: Real = 9.81;
 
-fn free_hinge() -> JointKind {
-    JointKind::Hinge {
-        limits: None,
-        motor: None,
-        spring: None,
-        servo: None,
-    }
-}
-
 /// A ball of `mass` (radius 5 cm) hanging `length` below a hinge to the world about z,
 /// with `armature`, let go `angle` (rad) from the vertical.
 fn pendulum(length: Real, mass: Real, armature: Real, angle: Real) -> (World, BodyId, JointId) {
@@ -87,15 +78,7 @@ fn a_slider_with_armature_falls_at_m_g_over_m_plus_a() {
         let body = w
             .create_body(&def, Shape::cuboid(Vec3::splat(0.1)))
             .unwrap();
-        let mut joint = JointDef::new(
-            JointKind::Slider {
-                limits: None,
-                motor: None,
-                spring: None,
-                servo: None,
-            },
-            body,
-        );
+        let mut joint = JointDef::new(free_slider(), body);
         joint.axis = Vec3::Y;
         joint.other_axis = Vec3::Y;
         joint.armature = armature;
@@ -309,15 +292,7 @@ fn an_armature_set_to_zero_mid_fall_leaves_nothing_behind() {
     let body = w
         .create_body(&BodyDef::default(), Shape::cuboid(Vec3::splat(0.1)))
         .unwrap();
-    let mut joint = JointDef::new(
-        JointKind::Slider {
-            limits: None,
-            motor: None,
-            spring: None,
-            servo: None,
-        },
-        body,
-    );
+    let mut joint = JointDef::new(free_slider(), body);
     (joint.axis, joint.other_axis) = (Vec3::Y, Vec3::Y);
     joint.armature = 3.0;
     let j = w.create_joint(&joint).unwrap();

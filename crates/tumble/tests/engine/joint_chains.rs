@@ -7,7 +7,7 @@
 // Casts between Real and f64 are no-ops in the default build but needed in the f32 one.
 #![allow(clippy::unnecessary_cast)]
 
-use crate::common::{awake, tol};
+use crate::common::{awake, free_hinge, free_slider, tol};
 use tumble::prelude::*;
 use tumble::{JointCoordinate, JointId};
 
@@ -23,24 +23,6 @@ fn body(w: &mut World, at: Vec3, mass: Real, half: Vec3, ghost: bool) -> BodyId 
         ..Default::default()
     };
     w.create_body(&def, Shape::cuboid(half)).unwrap()
-}
-
-fn hinge() -> JointKind {
-    JointKind::Hinge {
-        limits: None,
-        motor: None,
-        spring: None,
-        servo: None,
-    }
-}
-
-fn slider() -> JointKind {
-    JointKind::Slider {
-        limits: None,
-        motor: None,
-        spring: None,
-        servo: None,
-    }
 }
 
 /// Joins `body` to `other` (`None`: the world) by `kind` along `axis`, at `body`'s origin
@@ -83,10 +65,10 @@ fn a_planar_chain_holds_its_plane_and_its_free_directions_fall_freely() {
                     Vec3::new(0.05, 0.5, 0.05),
                     false,
                 );
-                join(&mut w, slider(), l1, None, Vec3::X);
-                join(&mut w, slider(), l2, Some(l1), Vec3::Y);
-                join(&mut w, hinge(), torso, Some(l2), Vec3::Z);
-                let mut def = JointDef::new(hinge(), arm);
+                join(&mut w, free_slider(), l1, None, Vec3::X);
+                join(&mut w, free_slider(), l2, Some(l1), Vec3::Y);
+                join(&mut w, free_hinge(), torso, Some(l2), Vec3::Z);
+                let mut def = JointDef::new(free_hinge(), arm);
                 (def.anchor, def.axis) = (Vec3::new(0.0, 0.5, 0.0), Vec3::Z);
                 (def.other, def.other_anchor, def.other_axis) =
                     (Some(torso), Vec3::new(0.3, 0.0, 0.0), Vec3::Z);
@@ -165,9 +147,9 @@ fn three_hinges_through_light_bodies_swing_as_one_ball_joint() {
         let balled = rod(&mut w, 5.0);
         let l1 = body(&mut w, pivot, 1e-2, Vec3::splat(0.05), true);
         let l2 = body(&mut w, pivot, 1e-2, Vec3::splat(0.05), true);
-        join(&mut w, hinge(), l1, None, Vec3::X);
-        join(&mut w, hinge(), l2, Some(l1), Vec3::Y);
-        let mut def = JointDef::new(hinge(), chained);
+        join(&mut w, free_hinge(), l1, None, Vec3::X);
+        join(&mut w, free_hinge(), l2, Some(l1), Vec3::Y);
+        let mut def = JointDef::new(free_hinge(), chained);
         def.anchor = Vec3::new(0.0, 1.0, 0.0);
         def.axis = tilt.inverse() * Vec3::Z;
         (def.other, def.other_anchor, def.other_axis) = (Some(l2), Vec3::ZERO, Vec3::Z);

@@ -10,15 +10,6 @@ use tumble::JointCoordinate;
 
 const G: Real = 9.8;
 
-fn free_hinge() -> JointKind {
-    JointKind::Hinge {
-        limits: None,
-        motor: None,
-        spring: None,
-        servo: None,
-    }
-}
-
 /// A box of `size` and `mass` at `position`.
 fn slab(w: &mut World, position: Vec3, size: Vec3, mass: Real) -> BodyId {
     w.create_body(
@@ -392,15 +383,7 @@ fn ball_and_slider_positions_read_and_set() {
     // A slider along x: the offset of body from the world anchor, and its rate.
     let mut w = awake(Vec3::ZERO);
     let block = slab(&mut w, Vec3::new(1.0, 0.0, 0.0), Vec3::splat(0.2), 2.0);
-    let mut def = JointDef::new(
-        JointKind::Slider {
-            limits: None,
-            motor: None,
-            spring: None,
-            servo: None,
-        },
-        block,
-    );
+    let mut def = JointDef::new(free_slider(), block);
     def.other_anchor = Vec3::new(1.0, 0.0, 0.0);
     let j = w.create_joint(&def).unwrap();
     assert_eq!(scalar(w.joint_position(j).unwrap()), 0.0);

@@ -382,15 +382,7 @@ fn a_slider_keeps_its_body_on_the_axis_and_a_weld_holds() {
     let mut w = awake(Vec3::new(0.0, -G, 0.0));
     let axis = Vec3::new(1.0, -1.0, 0.5).normalize();
     let body = unit_box(&mut w, Vec3::ZERO, 2.0);
-    let mut def = JointDef::new(
-        JointKind::Slider {
-            limits: None,
-            motor: None,
-            spring: None,
-            servo: None,
-        },
-        body,
-    );
+    let mut def = JointDef::new(free_slider(), body);
     def.axis = axis;
     def.other_axis = axis;
     w.create_joint(&def).unwrap();

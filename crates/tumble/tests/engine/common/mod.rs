@@ -17,6 +17,26 @@ pub fn single_precision() -> bool {
     std::mem::size_of::<Real>() == 4
 }
 
+/// A hinge with nothing on its free axis: no limits, motor, spring or servo.
+pub fn free_hinge() -> JointKind {
+    JointKind::Hinge {
+        limits: None,
+        motor: None,
+        spring: None,
+        servo: None,
+    }
+}
+
+/// A slider with nothing on its free axis.
+pub fn free_slider() -> JointKind {
+    JointKind::Slider {
+        limits: None,
+        motor: None,
+        spring: None,
+        servo: None,
+    }
+}
+
 /// A world with the given gravity and integrator.
 pub fn world(gravity: Vec3, integrator: Integrator) -> World {
     World::new(&WorldDef {
