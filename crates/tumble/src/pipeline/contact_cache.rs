@@ -3,7 +3,7 @@
 //! impulses it found then (warm starting).
 
 use crate::collision::broad_phase::{BroadPhase, Crowding};
-use crate::collision::contact::{Basis, Gate, Key, REUSE_DISTANCE};
+use crate::collision::contact::{Basis, Key, REUSE_DISTANCE};
 pub use crate::collision::contact::{Contact, ContactEvent, ContactEventKind};
 use crate::collision::geometry::{Aabb, Pose};
 use crate::collision::narrow_phase::{collide, collide_solids, ContactPoint, Manifold};
@@ -261,13 +261,8 @@ fn collide_in_place(
         contacts.pop();
         return;
     }
-    (contact.body_a, contact.body_b) = (w.ids[a], w.ids[b]);
-    (contact.index_a, contact.index_b) = (a as u32, b as u32);
-    contact.basis = Basis::of(&contact.manifold, pa, pb);
-    contact.new = true;
     // `push_new` for one manifold (`keep_deepest` keeps at least one).
-    let before = old.find(contact.key());
-    let (missed, matched) = warm_start(contact, before, (pa, pb));
+    let (missed, matched) = start_new(contact, old, (a, b), w.ids, (pa, pb));
     if missed != 0 {
         let first = contacts.len() - 1;
         warm_start_across(&mut contacts[first..], (&[missed], &[matched]), old);
@@ -469,6 +464,24 @@ fn keep_deepest(manifolds: &mut Vec<Manifold>, n: usize) {
     });
 }
 
+/// Makes `contact`, a blank (`Contact::BLANK`) holding a fresh manifold of bodies `a`
+/// and `b`, a new contact of theirs, warm-started from last step's; returns its
+/// unmatched and used points as `warm_start` does.
+fn start_new(
+    contact: &mut Contact,
+    old: &Sorted<'_>,
+    (a, b): (usize, usize),
+    ids: &[BodyId],
+    (pa, pb): (&Pose, &Pose),
+) -> (u32, u32) {
+    (contact.body_a, contact.body_b) = (ids[a], ids[b]);
+    (contact.index_a, contact.index_b) = (a as u32, b as u32);
+    contact.basis = Basis::of(&contact.manifold, pa, pb);
+    contact.new = true;
+    let before = old.find(contact.key());
+    warm_start(contact, before, (pa, pb))
+}
+
 /// Pushes a contact for each of the pair's freshly computed manifolds, warm-started from
 /// last step's.
 fn push_new(
@@ -486,20 +499,12 @@ fn push_new(
     let mut any = false;
     for manifold in manifolds {
         contacts.push(Contact {
-            body_a: ids[a],
-            body_b: ids[b],
             manifold: *manifold,
-            index_a: a as u32,
-            index_b: b as u32,
-            basis: Basis::of(manifold, pa, pb),
-            new: true,
-            gate: Gate::New,
-            edited: false,
+            ..Contact::BLANK
         });
         let k = contacts.len() - 1 - first;
         let contact = contacts.last_mut().expect("just pushed");
-        let before = old.find(contact.key());
-        let (missed, matched) = warm_start(contact, before, (pa, pb));
+        let (missed, matched) = start_new(contact, old, (a, b), ids, (pa, pb));
         if let (Some(m), Some(u)) = (unmatched.get_mut(k), used.get_mut(k)) {
             (*m, *u) = (missed, matched);
             any |= missed != 0;
