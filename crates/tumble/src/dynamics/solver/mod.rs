@@ -269,7 +269,7 @@ impl Solver {
     ) {
         let (h, world_bodies) = (input.time.h, input.system.bodies);
         let t = input.time.t + i as Real * h;
-        self.begin_armatures(&mut bodies.states);
+        self.for_armatures(&mut bodies.states, JointConstraint::begin_armature);
         // After a split kick's second half the forces are those of this substep's start.
         self.kick(bodies, input.system, t, h, (i == 0 || !any_split, false));
         if self.fine > 1 {
@@ -297,28 +297,24 @@ impl Solver {
         if iterations == 0 {
             ContactConstraint::add_to_totals(&self.points.hot, &mut self.points.cold);
         }
-        self.end_armatures(&mut bodies.states);
+        self.for_armatures(&mut bodies.states, JointConstraint::end_armature);
         self.add_joint_totals();
     }
 
-    /// Starts the substep's armature flywheels (see `joint_armature.rs`) at the rates
-    /// before the kick.
-    fn begin_armatures(&mut self, states: &mut [BodyState]) {
+    /// `f` on every joint with its frame when a joint has an armature (see
+    /// `joint_armature.rs`): its flywheel started before the kick
+    /// (`JointConstraint::begin_armature`), its lag kept at the substep's end
+    /// (`end_armature`).
+    fn for_armatures(
+        &mut self,
+        states: &mut [BodyState],
+        f: impl Fn(&mut JointConstraint, &JointFrame, &mut [BodyState]),
+    ) {
         if !self.armatures {
             return;
         }
         for (j, fr) in self.joints.iter_mut().zip(&self.joint_frames) {
-            j.begin_armature(fr, states);
-        }
-    }
-
-    /// Keeps each flywheel's lag behind its coordinate for the next substep.
-    fn end_armatures(&mut self, states: &mut [BodyState]) {
-        if !self.armatures {
-            return;
-        }
-        for (j, fr) in self.joints.iter_mut().zip(&self.joint_frames) {
-            j.end_armature(fr, states);
+            f(j, fr, states);
         }
     }
 
