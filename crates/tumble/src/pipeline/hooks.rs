@@ -184,7 +184,7 @@ pub(crate) struct OneWayRule {
 
 /// The least cosine between a one-way body's normal and a manifold's normal towards the
 /// other body that keeps the manifold: within 60°.
-const ONE_WAY_COS: Real = 0.5;
+pub(crate) const ONE_WAY_COS: Real = 0.5;
 
 /// The hooks and what they hand to the rest of the step.
 #[derive(Default)]

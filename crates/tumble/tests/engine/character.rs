@@ -917,3 +917,110 @@ fn overlaps_are_pushed_out_and_a_squeeze_is_survived() {
         assert!(p.is_finite() && p.x.abs() < 0.25, "{p}");
     }
 }
+
+/// A static body that is only a trigger volume: a sensor box 2 m tall across the path.
+fn trigger(w: &mut World, x: Real) -> BodyId {
+    let def = BodyDef {
+        kind: BodyKind::Static,
+        position: Vec3::new(x, 1.0, 0.0),
+        sensor: true,
+        ..Default::default()
+    };
+    w.create_body(&def, Shape::cuboid(Vec3::new(0.5, 1.0, 3.0)))
+        .unwrap()
+}
+
+/// A sensor stops nothing: walking at 2 m/s for 2 s across a trigger box taller than the
+/// character, it ends 4 m on (to rounding), on the ground all the way; before sensors
+/// were passed over, the box stopped it a skin short of its face like a wall.
+#[test]
+fn a_sensor_does_not_stop_the_character() {
+    for (r, dt) in radii_and_steps() {
+        let mut w = flat_world();
+        trigger(&mut w, 2.0);
+        let mut c = standing(
+            &w,
+            0.0,
+            CharacterDef {
+                radius: r,
+                ..Default::default()
+            },
+        );
+        let mut walker = Walker::new();
+        let steps = (2.0 / dt).round() as usize;
+        for _ in 0..steps {
+            walker.step(&mut c, &mut w, Vec3::new(2.0, 0.0, 0.0), dt);
+            assert!(c.on_ground(), "r {r} dt {dt}: off the ground");
+        }
+        let x = c.position().x;
+        let end = 2.0 * steps as Real * dt;
+        assert!(
+            (x - end).abs() < tol(1e-9, 1e-4),
+            "r {r} dt {dt}: x {x} vs {end}"
+        );
+    }
+}
+
+/// A one-way platform (a static slab whose top is at y = 2.5 m, 0.2 m thick, one way
+/// +y) over a character that jumps at 8 m/s: it rises through the slab as in free flight
+/// (its apex that of the discrete flight, about v²/2g = 3.3 m up, to two skins: the frame
+/// its feet come out of the top less than a skin deep, the top already holds it and lifts
+/// it to a skin above) and lands on the top a skin above it (to half a skin), staying there. The
+/// same slab without `one_way` stops the jump under it: the test tells them apart.
+#[test]
+fn a_character_jumps_up_through_a_one_way_platform_and_lands_on_it() {
+    for (r, dt) in radii_and_steps() {
+        for one_way in [true, false] {
+            let mut w = flat_world();
+            let def = BodyDef {
+                kind: BodyKind::Static,
+                position: Vec3::new(0.0, 2.4, 0.0),
+                one_way: one_way.then_some(Vec3::Y),
+                ..Default::default()
+            };
+            w.create_body(&def, Shape::cuboid(Vec3::new(3.0, 0.1, 3.0)))
+                .unwrap();
+            let mut c = standing(
+                &w,
+                0.0,
+                CharacterDef {
+                    radius: r,
+                    ..Default::default()
+                },
+            );
+            let y0 = c.position().y;
+            let (v0, mut vy, mut apex): (Real, Real, Real) = (8.0, 8.0, y0);
+            for _ in 0..(2.0 / dt).round() as usize {
+                c.move_by(&mut w, Vec3::new(0.0, vy * dt, 0.0), dt).unwrap();
+                apex = apex.max(c.position().y);
+                vy = if c.on_ground() && vy <= 0.0 {
+                    0.0
+                } else {
+                    vy - G * dt
+                };
+            }
+            let y = c.position().y;
+            if one_way {
+                // The discrete flight: after n frames v₀ n dt − g dt² n (n − 1)/2.
+                let rise = (0..(2.0 / dt) as usize)
+                    .map(|n| n as Real)
+                    .map(|n| v0 * dt * n - G * dt * dt * n * (n - 1.0) / 2.0)
+                    .fold(0.0, Real::max);
+                assert!(
+                    (apex - y0 - rise).abs() < 2.0 * SKIN,
+                    "r {r} dt {dt}: apex {apex}"
+                );
+                let on_top = 2.5 + r + 0.6 + SKIN;
+                assert!(c.on_ground(), "r {r} dt {dt}: not on the platform");
+                assert!((y - on_top).abs() <= 0.5 * SKIN, "r {r} dt {dt}: y {y}");
+            } else {
+                let under = 2.3 - r - 0.6;
+                assert!(
+                    apex < under,
+                    "r {r} dt {dt}: through a solid slab to {apex}"
+                );
+                assert!((y - y0).abs() <= 0.5 * SKIN, "r {r} dt {dt}: y {y}");
+            }
+        }
+    }
+}

@@ -19,6 +19,10 @@
 //! follows `position` (the scene format does that, with a body that collides with
 //! nothing, so that outputs and pictures show the character).
 //!
+//! Sensors do not block it (a trigger volume is walked through), and one-way bodies block
+//! it only from their side, as the contact hooks decide for bodies: it jumps up through
+//! a one-way platform and lands on it (`surface.rs`, `Owner::blocks`).
+//!
 //! One move (`move_by`), in order:
 //!
 //! 1. **Slide**: up to [`MAX_SLIDES`] passes of: gather the surfaces within two skins,

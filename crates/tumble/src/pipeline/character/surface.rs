@@ -15,6 +15,7 @@ use crate::collision::shape::{Convex, Shape};
 use crate::dynamics::body::BodyKind;
 use crate::id::BodyId;
 use crate::math::{Quat, Real, Vec3};
+use crate::pipeline::hooks::ONE_WAY_COS;
 use crate::pipeline::world::query::QueryFilter;
 use crate::pipeline::world::World;
 
@@ -167,20 +168,51 @@ fn for_each_piece(shape: &Shape, pose: &Pose, region: &Aabb, f: &mut dyn FnMut(&
     }
 }
 
-/// Calls `f(body, mass if dynamic, piece)` for every piece of every body the capsule's
-/// filter lets through whose bounding box meets `region`, in body order.
+/// The body a piece belongs to, as the character's queries see it.
+#[derive(Clone, Copy)]
+struct Owner {
+    id: BodyId,
+    /// Its mass if it is dynamic (so it can be pushed).
+    dynamic: Option<Real>,
+    /// A one-way body's normal in the world frame (see [`Owner::blocks`]).
+    one_way: Option<Vec3>,
+}
+
+impl Owner {
+    /// Whether a surface of this body with unit `normal` (towards the capsule) and
+    /// `separation` blocks the capsule. Every surface does but a one-way body's, which
+    /// blocks only from its own side as the contact hooks decide for bodies
+    /// (`pipeline/hooks.rs`): a normal within 60° of the body's, and the capsule not sunk
+    /// more than a skin into it. A character jumping up through a platform is thus neither
+    /// stopped by its underside nor pushed out sideways while inside it, and lands on it
+    /// once above.
+    fn blocks(&self, normal: Vec3, separation: Real, skin: Real) -> bool {
+        self.one_way
+            .is_none_or(|n| normal.dot(n) >= ONE_WAY_COS && separation >= -skin)
+    }
+}
+
+/// Calls `f(owner, piece)` for every piece of every body the capsule's filter lets
+/// through whose bounding box meets `region`, in body order. Sensors are passed over:
+/// they detect bodies but stop none, and a character walks through a trigger volume.
 fn for_each_body_piece(
     world: &World,
     capsule: &Capsule,
     region: &Aabb,
-    f: &mut dyn FnMut(BodyId, Option<Real>, &Piece<'_>),
+    f: &mut dyn FnMut(Owner, &Piece<'_>),
 ) {
     for id in world.query_aabb(region, &capsule.filter) {
         let Ok(body) = world.body(id) else { continue };
-        let dynamic = (body.kind() == BodyKind::Dynamic).then(|| body.mass());
-        for_each_piece(body.shape(), &body.pose(), region, &mut |piece| {
-            f(id, dynamic, piece)
-        });
+        if body.is_sensor() {
+            continue;
+        }
+        let pose = body.pose();
+        let owner = Owner {
+            id,
+            dynamic: (body.kind() == BodyKind::Dynamic).then(|| body.mass()),
+            one_way: body.one_way().map(|n| pose.transform_vector(n)),
+        };
+        for_each_piece(body.shape(), &pose, region, &mut |piece| f(owner, piece));
     }
 }
 
@@ -189,15 +221,16 @@ fn for_each_body_piece(
 pub(super) fn touches(world: &World, capsule: &Capsule, center: Vec3, margin: Real) -> Vec<Touch> {
     let region = capsule.aabb(center).expanded(margin);
     let mut found = Vec::new();
-    for_each_body_piece(world, capsule, &region, &mut |body, dynamic, piece| {
+    for_each_body_piece(world, capsule, &region, &mut |owner, piece| {
         let gap = capsule.gap(center, piece);
-        if gap.distance < margin && gap.normal.is_finite() {
+        let blocks = || owner.blocks(-gap.normal, gap.distance, capsule.skin);
+        if gap.distance < margin && gap.normal.is_finite() && blocks() {
             found.push(Touch {
-                body,
+                body: owner.id,
                 normal: -gap.normal,
                 separation: gap.distance,
                 point: gap.point,
-                dynamic,
+                dynamic: owner.dynamic,
             });
         }
     });
@@ -215,17 +248,21 @@ pub(super) fn sweep(world: &World, capsule: &Capsule, from: Vec3, delta: Vec3) -
         .union(&capsule.aabb(from + delta))
         .expanded(2.0 * capsule.skin);
     let mut first: Option<Hit> = None;
-    for_each_body_piece(world, capsule, &region, &mut |body, dynamic, piece| {
+    for_each_body_piece(world, capsule, &region, &mut |owner, piece| {
+        // A one-way body stops only a move into it from its side.
+        if owner.one_way.is_some_and(|n| delta.dot(n) >= 0.0) {
+            return;
+        }
         let Some((t, gap)) = advance(capsule, from, delta, piece) else {
             return;
         };
-        if first.is_none_or(|f| t < f.t) {
+        if first.is_none_or(|f| t < f.t) && owner.blocks(-gap.normal, gap.distance, capsule.skin) {
             let touch = Touch {
-                body,
+                body: owner.id,
                 normal: -gap.normal,
                 separation: gap.distance,
                 point: gap.point,
-                dynamic,
+                dynamic: owner.dynamic,
             };
             first = Some(Hit { t, touch });
         }
