@@ -541,6 +541,57 @@ fn joint_reactions_are_written_and_carry_the_load() {
 }
 
 #[test]
+fn slider_and_ball_coordinates_are_written_in_their_columns() {
+    // No gravity: a box on a slider along x set moving at 0.5 m/s, and a ball spinning at
+    // 2 rad/s about z on a ball joint at its centre (no torque: ω stays). At time t the
+    // slider's offset is 0.5 t (its anchors coincide at creation) in `position`, its rate
+    // 0.5 in `velocity`, the vector columns empty; the ball's rotation vector is (0, 0, 2t)
+    // in `position_x..z` (t = 1 s: under π), its relative ω (0, 0, 2) in `velocity_x..z`,
+    // the scalar columns empty. To 1e-9 (free motion, integrated exactly up to rounding).
+    let dir = scratch("coordinates_csv");
+    let scene = dir.join("coordinates.json");
+    std::fs::write(
+        &scene,
+        r#"{"gravity": [0, 0, 0], "dt": 0.01, "duration": 1.0, "bodies": [
+            {"name": "carriage", "position": [0, 1, 0], "velocity": [0.5, 0, 0],
+             "shape": {"type": "box", "half_extents": [0.2, 0.1, 0.1]}},
+            {"name": "globe", "position": [3, 1, 0], "angular_velocity": [0, 0, 2],
+             "shape": {"type": "sphere", "radius": 0.3}}
+        ], "joints": [
+            {"type": "slider", "name": "rail", "body": "carriage", "axis": [1, 0, 0]},
+            {"type": "ball", "name": "pivot", "body": "globe"}
+        ]}"#,
+    )
+    .unwrap();
+    let file = dir.join("joints.csv");
+    ok(&["run", path(&scene), "--joints", path(&file), "--quiet"]);
+    let text = std::fs::read_to_string(file).unwrap();
+    let mut seen = 0;
+    for line in text.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let t: f64 = f[0].parse().unwrap();
+        let num = |k: usize| f[k].parse::<f64>().unwrap();
+        let close = |k: usize, x: f64| (num(k) - x).abs() < 1e-9;
+        match f[1] {
+            "rail" => {
+                assert!(close(11, 0.5 * t) && close(12, 0.5), "{line}");
+                assert!(f[13..].iter().all(|c| c.is_empty()), "{line}");
+            }
+            "pivot" => {
+                assert!(f[11].is_empty() && f[12].is_empty(), "{line}");
+                let expected = [0.0, 0.0, 2.0 * t, 0.0, 0.0, 2.0];
+                for (k, x) in (13..19).zip(expected) {
+                    assert!(close(k, x), "column {k}: {line}");
+                }
+            }
+            other => panic!("unknown joint {other}"),
+        }
+        seen += 1;
+    }
+    assert!(seen >= 4, "{seen} rows");
+}
+
+#[test]
 fn sensor_events_are_written_at_every_step() {
     // A ball of radius 0.1 dropped from y = 5 through a sensor slab y in [1, 2]: it enters
     // when its bottom reaches 2, at t = √(2·2.9/g), and leaves when its top passes 1, at

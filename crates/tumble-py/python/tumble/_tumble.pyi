@@ -642,6 +642,7 @@ class World:
         limits: Optional[Sequence[float]] = None,
         motor: Optional[Motor] = None,
         spring: Optional[JointSpring] = None,
+        servo: Optional[Servo] = None,
         length: Optional[float] = None,
         min: Optional[float] = None,
         max: Optional[float] = None,
