@@ -221,61 +221,10 @@ def test_pusher_reaches_goal():
     assert term and r > 5 and abs(obs[2] - 0.3) < 0.05
 
 
-class FakeBatch:
-    """The part of tumble.Batch's API (issue 20, point 1) that tumble.envs.vector uses,
-    made of W separate Worlds, so that the vector environments' own logic (arrays, actions,
-    autoreset) is tested before the real Batch is built in; with it, the test below runs
-    against the real one."""
-
-    def __init__(self, world, copies, threads=None):
-        self._start = world.snapshot()
-        self.worlds = [tumble.World.from_snapshot(self._start) for _ in range(copies)]
-        self._forces = [[] for _ in range(copies)]
-
-    def _get(self, name):
-        return np.stack([getattr(w, name) for w in self.worlds])
-
-    def _put(self, name, value):
-        for w, v in zip(self.worlds, np.asarray(value, dtype=float)):
-            setattr(w, name, v)
-
-    positions = property(lambda s: s._get("positions"), lambda s, v: s._put("positions", v))
-    orientations = property(lambda s: s._get("orientations"), lambda s, v: s._put("orientations", v))
-    velocities = property(lambda s: s._get("velocities"), lambda s, v: s._put("velocities", v))
-    angular_velocities = property(
-        lambda s: s._get("angular_velocities"), lambda s, v: s._put("angular_velocities", v)
-    )
-
-    def step(self, dt=None, steps=1):
-        for w in self.worlds:
-            w.step(dt, steps=steps)
-
-    def reset(self, worlds=None, snapshot=None, **arrays):
-        for k, i in enumerate(range(len(self.worlds)) if worlds is None else worlds):
-            self.worlds[i].restore(snapshot or self._start)
-            self._forces[i] = []
-            self.worlds[i].set_state(**{name: a[k] for name, a in arrays.items()})
-
-    def set_joint_targets(self, name, values, *, kind=None):
-        assert kind == "velocity"
-        for w, v in zip(self.worlds, values):
-            j = w.joint(name)
-            j.motor = tumble.Motor(float(v), j.motor.max_force)
-
-    def apply_forces(self, forces, torques=None):
-        for i, w in enumerate(self.worlds):
-            for f in self._forces[i]:
-                w.remove_force(f)
-            self._forces[i] = [
-                w.add_force(b, force=forces[i][n], torque=None if torques is None else torques[i][n])
-                for n, b in enumerate(w.bodies)
-            ]
-
-
 @pytest.fixture()
-def batch_api(monkeypatch):
-    if not hasattr(tumble, "Batch"):
-        monkeypatch.setattr(tumble, "Batch", FakeBatch, raising=False)
+def batch_api():
+    """The real tumble.Batch: the vector environments are tested against it alone (a
+    stand-in of W Worlds, written before Batch existed, could have hidden a broken one)."""
     return tumble.Batch
 
 

@@ -13,10 +13,6 @@ world's motor speed to ±FAR); Pendulum's and Acrobot's torques are body torques
 the single environments. The Pusher
 has no vectorised version (its pusher is moved by kinematic targets, which a Batch does
 not take per world).
-
-STATUS: written against the Batch API of issue 20 point 1 before that was merged; it needs
-``tumble.Batch``. tests/test_envs.py runs it against a stand-in made of W Worlds (the
-part of Batch's API used here) until the real one is built in.
 """
 
 from __future__ import annotations
