@@ -85,11 +85,14 @@ impl PyWorld {
     /// `self_collision` makes the model's links that no joint connects collide with each
     /// other (default False, as PyBullet's: they still collide with everything else).
     /// Bodies and joints are named as in the file (`world.body("upper")`,
-    /// `world.joint("elbow")`). A bad file raises ValueError naming file, line and element.
+    /// `world.joint("elbow")`). What the file has that is not built as written (an impossible
+    /// inertia taken from the geometry, say) comes out as Python warnings (UserWarning), as
+    /// `add_urdf` lists it. A bad file raises ValueError naming file, line and element.
     #[staticmethod]
     #[pyo3(signature = (path, *, fixed_base = true, gravity = None, position = None,
         orientation = None, merge_fixed = true, self_collision = false))]
     fn from_urdf(
+        py: Python<'_>,
         path: std::path::PathBuf,
         fixed_base: bool,
         gravity: Option<&Bound<'_, PyAny>>,
@@ -111,7 +114,13 @@ impl PyWorld {
             self_collision,
         )?;
         let mut world = World::try_new(&def).map_err(engine)?;
-        urdf::load(&path, &mut world, &opts).map_err(scene)?;
+        let model = urdf::load(&path, &mut world, &opts).map_err(scene)?;
+        // What was read but not built as written, as `add_urdf` lists it in `warnings`.
+        let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+        for w in &model.warnings {
+            let text = std::ffi::CString::new(w.replace('\0', "\\0"))?;
+            PyErr::warn(py, &category, &text, 1)?;
+        }
         Ok(PyWorld::new_inner(Inner {
             world,
             dt: tumble_scene::DEFAULT_DT,

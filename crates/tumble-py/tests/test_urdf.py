@@ -138,6 +138,10 @@ def test_an_impossible_inertia_is_a_warning_as_pybullet_loads_it(tmp_path):
     assert len(m.warnings) == 1
     assert "inertial.inertia: is not positive definite" in m.warnings[0]
     assert "not used (the link does not move)" in m.warnings[0]
+    # from_urdf has no model to return: the same text comes out as a UserWarning.
+    with pytest.warns(UserWarning, match="is not positive definite") as caught:
+        tumble.World.from_urdf(path)
+    assert [str(w.message) for w in caught] == m.warnings
 
 
 # --- against PyBullet -------------------------------------------------------------------

@@ -535,7 +535,8 @@ class World:
     ) -> World:
         """A world holding a URDF model; gravity defaults to z-up (0, 0, -9.81).
         Bodies and joints are named as in the file. The model's links collide with each
-        other only with self_collision=True. ValueError names file:line and element."""
+        other only with self_collision=True. What is not built as written comes out as
+        UserWarnings (add_urdf's `warnings`). ValueError names file:line and element."""
     def add_urdf(
         self,
         path: Union[str, PathLike[str]],
