@@ -409,10 +409,16 @@ impl PyWorld {
         }))
     }
 
-    /// Loads a scene from JSON text (docs/scene-format.md).
+    /// Loads a scene from JSON text (docs/scene-format.md); its relative paths (`models`
+    /// files) are read from `folder`, else from the working directory.
     #[staticmethod]
-    fn from_json(text: String) -> PyResult<Self> {
-        let s = tumble_scene::load_str(&text).map_err(scene)?;
+    #[pyo3(signature = (text, folder = None))]
+    fn from_json(text: String, folder: Option<std::path::PathBuf>) -> PyResult<Self> {
+        let s = match folder {
+            Some(dir) => tumble_scene::load_str_in(&text, &dir),
+            None => tumble_scene::load_str(&text),
+        }
+        .map_err(scene)?;
         Ok(PyWorld::new_inner(Inner {
             world: s.world,
             dt: s.dt,

@@ -135,6 +135,32 @@ def test_built_in_scene_and_file(tmp_path):
         assert r["ball.y"] == pytest.approx(5 - g * 0.01**2 * 100 * 101 / 2, abs=1e-9)
 
 
+BLOCK_URDF = (
+    "<robot name='r'><link name='block'><inertial><mass value='2'/>"
+    "<inertia ixx='0.1' iyy='0.1' izz='0.1' ixy='0' ixz='0' iyz='0'/></inertial>"
+    "<collision><geometry><box size='0.2 0.2 0.2'/></geometry></collision></link></robot>"
+)
+
+
+def test_a_scene_files_models_are_read_from_its_folder(tmp_path, monkeypatch):
+    # A scene file placing a URDF by a relative path, swept from another working directory:
+    # the model is read next to the scene (as `tumble run` and `tumble sweep` read it), and
+    # falls freely: y = 3 - g h² n (n + 1) / 2 after n = 50 symplectic Euler steps of 0.01 s.
+    folder = tmp_path / "models"
+    folder.mkdir()
+    (folder / "block.urdf").write_text(BLOCK_URDF)
+    scene = {"gravity": [0, -9.8, 0], "dt": 0.01, "bodies": [],
+             "models": [{"file": "block.urdf", "position": [0, 3, 0], "fixed_base": False}]}
+    (folder / "scene.json").write_text(json.dumps(scene))
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    rows = records(tumble.sweep(str(folder / "scene.json"), {"dt": [0.01]}, ["block.y"],
+                                duration=0.5, use_ray=False, progress=False))
+    assert rows[0]["error"] is None, rows[0]["error"]
+    assert rows[0]["block.y"] == pytest.approx(3 - 9.8 * 0.01**2 * 50 * 51 / 2, abs=1e-9)
+
+
 CLI_SETS = ["bodies[ball].restitution=0,0.5,0.9", "bodies[0].friction=0.3,1", "gravity=[0,-9.8,0],[0,-3,0]"]
 CLI_METRICS = ["ball.y", "ball.vy", "ball.max_y", "box.speed", "kinetic_energy", "asleep", "time"]
 

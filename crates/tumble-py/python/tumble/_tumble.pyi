@@ -509,8 +509,9 @@ class World:
     def from_scene(path: Union[str, PathLike[str]]) -> World:
         """Loads a scene file, or a built-in scene by name (tumble.SCENES)."""
     @staticmethod
-    def from_json(text: str) -> World:
-        """Loads a scene from JSON text."""
+    def from_json(text: str, folder: Optional[Union[str, PathLike[str]]] = None) -> World:
+        """Loads a scene from JSON text; relative `models` paths are read from `folder`
+        (default: the working directory)."""
     @staticmethod
     def from_mjcf(path: Union[str, PathLike[str]]) -> World:
         """Loads an MJCF (MuJoCo XML) model: names, joints and gravity from the file;

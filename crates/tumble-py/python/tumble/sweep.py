@@ -85,6 +85,16 @@ def load_document(scene: Scene) -> dict:
         raise ValueError(f"scene: invalid JSON at line {e.lineno} column {e.colno}: {e.msg}") from None
 
 
+def scene_folder(scene: Scene) -> Optional[str]:
+    """The folder a scene file's relative paths (its ``models`` files) are read from: the
+    file's own, as the CLI reads them; None for a dict or a built-in scene."""
+    import tumble
+
+    if isinstance(scene, Mapping) or os.fspath(scene) in tumble.SCENES:
+        return None
+    return os.path.dirname(os.path.abspath(os.fspath(scene)))
+
+
 def parse_path(path: str) -> list:
     """``bodies[ball].shape.radius`` -> ["bodies", "[ball]", "shape", "radius"]."""
     steps, pos, expect_key = [], 0, True
@@ -226,16 +236,23 @@ def _body(world, body: str):
         raise ValueError(f"metric: no body named '{body}'") from None
 
 
-def run_one(doc: dict, params: Mapping[str, Any], metrics: Any, duration: Optional[float]) -> dict:
-    """One combination: patch, load, step for `duration`, measure. Never raises: a failure
-    is the row's ``error`` (the loader's or engine's one line, or the metric's exception)."""
+def run_one(
+    doc: dict,
+    params: Mapping[str, Any],
+    metrics: Any,
+    duration: Optional[float],
+    folder: Optional[str] = None,
+) -> dict:
+    """One combination: patch, load (relative paths from `folder`), step for `duration`,
+    measure. Never raises: a failure is the row's ``error`` (the loader's or engine's one
+    line, or the metric's exception)."""
     import numpy as np
 
     import tumble
 
     row: dict = {"params": dict(params), "metrics": {}, "error": None}
     try:
-        world = tumble.World.from_json(json.dumps(patched(doc, params)))
+        world = tumble.World.from_json(json.dumps(patched(doc, params)), folder=folder)
         menu = getattr(metrics, "menu", None)
         wants_max = menu is not None and any(m.endswith(".max_y") for m in menu)
         if wants_max:
@@ -285,10 +302,10 @@ def _report(progress: Progress, done: int, total: int, row: dict) -> None:
         print(f"[{done}/{total}] {params}: {status}", file=sys.stderr, flush=True)
 
 
-def _serial(doc, combos, metrics, duration, progress) -> list:
+def _serial(doc, combos, metrics, duration, progress, folder) -> list:
     rows = []
     for combo in combos:
-        rows.append(run_one(doc, combo, metrics, duration))
+        rows.append(run_one(doc, combo, metrics, duration, folder))
         _report(progress, len(rows), len(combos), rows[-1])
     return rows
 
@@ -305,7 +322,7 @@ def _by_value(ray, metrics) -> None:
         pass
 
 
-def _on_ray(doc, combos, metrics, duration, progress, address, num_cpus) -> list:
+def _on_ray(doc, combos, metrics, duration, progress, address, num_cpus, folder) -> list:
     try:
         import ray
     except ImportError:
@@ -320,7 +337,9 @@ def _on_ray(doc, combos, metrics, duration, progress, address, num_cpus) -> list
         _by_value(ray, metrics)
         task = ray.remote(num_cpus=1)(run_one)
         doc_ref, metrics_ref = ray.put(doc), ray.put(metrics)
-        pending = {task.remote(doc_ref, combo, metrics_ref, duration): i for i, combo in enumerate(combos)}
+        pending = {
+            task.remote(doc_ref, combo, metrics_ref, duration, folder): i for i, combo in enumerate(combos)
+        }
         rows: list = [None] * len(combos)
         done = 0
         while pending:
@@ -385,7 +404,7 @@ def sweep(
     A path that names nothing in the scene (an unknown body, an index out of range) is a
     ValueError before anything runs; a bad value fails only its runs.
     """
-    doc = load_document(scene)
+    doc, folder = load_document(scene), scene_folder(scene)
     combos = combinations(grid)
     for path in grid:
         resolve(json.loads(json.dumps(doc)), path)
@@ -395,9 +414,9 @@ def sweep(
         raise ValueError(f"duration: must be a finite number >= 0, got {duration!r}")
     serial = use_ray is False or address == SERIAL
     if serial:
-        rows = _serial(doc, combos, metrics, duration, progress)
+        rows = _serial(doc, combos, metrics, duration, progress, folder)
     else:
-        rows = _on_ray(doc, combos, metrics, duration, progress, address, num_cpus)
+        rows = _on_ray(doc, combos, metrics, duration, progress, address, num_cpus, folder)
     return table(rows, list(grid))
 
 
