@@ -69,6 +69,7 @@ impl World {
         c.contacts.forget(id, dense);
         self.remove_joints_of(id);
         self.remove_forces_of(id);
+        self.joints.excluded.retain(|&(a, b)| a != id && b != id);
         // The bodies after it moved down one place: the joints' links follow now, not at
         // the next step, for what reads them before (setting a joint's coordinate).
         self.refresh_joint_links();

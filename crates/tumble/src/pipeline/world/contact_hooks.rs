@@ -27,6 +27,58 @@ impl World {
         self.wake_all();
     }
 
+    /// Keeps bodies `a` and `b` from ever touching, as a joint between them does (MuJoCo's
+    /// `<contact><exclude>`): no manifold, no CCD stop. Unlike a contact filter this is
+    /// data: a world holding such pairs is copied ([`crate::Batch`]), snapshotted and
+    /// saved with them. Excluding a pair twice changes nothing; both bodies are woken.
+    /// Errors: an unknown body, or `a == b`.
+    pub fn exclude_contacts(&mut self, a: BodyId, b: BodyId) -> Result<()> {
+        let pair = self.contact_pair(a, b)?;
+        if let Err(at) = self.joints.excluded.binary_search(&pair) {
+            self.joints.excluded.insert(at, pair);
+            self.refresh_joint_links();
+        }
+        Ok(())
+    }
+
+    /// Lets bodies `a` and `b` touch again after [`World::exclude_contacts`] (a joint
+    /// between them still keeps them apart unless it collides connected); returns whether
+    /// the pair was excluded. Both bodies are woken.
+    pub fn allow_contacts(&mut self, a: BodyId, b: BodyId) -> Result<bool> {
+        let pair = self.contact_pair(a, b)?;
+        let Ok(at) = self.joints.excluded.binary_search(&pair) else {
+            return Ok(false);
+        };
+        self.joints.excluded.remove(at);
+        self.refresh_joint_links();
+        Ok(true)
+    }
+
+    /// The pairs [`World::exclude_contacts`] keeps apart, each (older handle, newer),
+    /// sorted.
+    pub fn excluded_contacts(&self) -> &[(BodyId, BodyId)] {
+        &self.joints.excluded
+    }
+
+    /// `(a, b)` checked and ordered, both bodies woken.
+    fn contact_pair(&mut self, a: BodyId, b: BodyId) -> Result<(BodyId, BodyId)> {
+        let unknown = |field: &str, id| Error::UnknownBody {
+            field: field.into(),
+            id,
+        };
+        let i = self.dense(a).ok_or_else(|| unknown("a", a))?;
+        let j = self.dense(b).ok_or_else(|| unknown("b", b))?;
+        if a == b {
+            return Err(Error::invalid(
+                "exclude",
+                "a body cannot be excluded from itself",
+            ));
+        }
+        self.wake_around(i);
+        self.wake_around(j);
+        Ok((a.min(b), a.max(b)))
+    }
+
     /// Removes the contact filter: every pair the broad phase finds may touch again.
     pub fn clear_contact_filter(&mut self) {
         self.hooks.set_filter(None);

@@ -127,8 +127,7 @@ impl World {
     }
 
     /// Re-derives each joint's dense body indices (broken and disabled joints join
-    /// nothing) and the
-    /// pairs that must not collide.
+    /// nothing) and the pairs that must not collide (those joints and the excluded pairs).
     pub(crate) fn refresh_joint_links(&mut self) {
         let links: Vec<[Option<usize>; 2]> = self
             .joints
@@ -153,6 +152,13 @@ impl World {
                         .joined_pairs
                         .push((a.min(b) as u32, a.max(b) as u32));
                 }
+            }
+        }
+        for k in 0..self.joints.excluded.len() {
+            let (a, b) = self.joints.excluded[k];
+            if let (Some(a), Some(b)) = (self.dense(a), self.dense(b)) {
+                let pair = (a.min(b) as u32, a.max(b) as u32);
+                self.joints.joined_pairs.push(pair);
             }
         }
         self.joints.joined_pairs.sort_unstable();

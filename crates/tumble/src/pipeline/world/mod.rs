@@ -200,8 +200,13 @@ pub(crate) struct JointStore {
     pub handles: Handles<JointId>,
     /// Each joint's bodies as dense indices (`None`: the world, or a broken joint).
     pub links: Vec<[Option<usize>; 2]>,
-    /// Dense body pairs a joint keeps from colliding, sorted.
+    /// Dense body pairs that must not collide, sorted: those a joint keeps apart and the
+    /// `excluded` ones.
     pub joined_pairs: Vec<(u32, u32)>,
+    /// Body pairs kept from touching by [`World::exclude_contacts`], each (lower, higher),
+    /// sorted. Data, not code (unlike a contact filter), so a world holding them is copied,
+    /// snapshotted and saved whole.
+    pub excluded: Vec<(BodyId, BodyId)>,
 }
 
 /// What collision detection keeps between steps.
@@ -579,7 +584,8 @@ crate::codec::codec_struct!(JointStore {
     list,
     handles,
     links,
-    joined_pairs
+    joined_pairs,
+    excluded
 });
 crate::codec::codec_struct!(CollisionStore {
     broad_phase,
