@@ -49,7 +49,7 @@ pub use body::check_name;
 
 use reader::{Node, Obj};
 
-const TOP_KEYS: [&str; 26] = [
+const TOP_KEYS: [&str; 27] = [
     "name",
     "description",
     "gravity",
@@ -76,6 +76,7 @@ const TOP_KEYS: [&str; 26] = [
     "character",
     "state",
     "models",
+    "exclude",
 ];
 
 /// The most `substeps` and `iterations` a scene or the command line may ask for.
@@ -261,6 +262,7 @@ fn build(root: &Node<'_>, dir: &Path) -> Result<Scene> {
     let warnings = models::add_models(&obj, dir, &mut world, &mut body_names, &mut body_colors)?;
     add_forces(&obj, &mut world)?;
     add_joints(&obj, &mut world)?;
+    add_exclusions(&obj, &mut world)?;
     let character = match obj.get("character") {
         Some(node) => {
             let (walker, label, color) = character::character(&node, &mut world)?;
@@ -459,6 +461,27 @@ fn add_joints(obj: &Obj<'_>, world: &mut World) -> Result<()> {
         world
             .create_joint(&def)
             .map_err(|e| SceneError::from_engine(e, node.path()))?;
+    }
+    Ok(())
+}
+
+/// `exclude`: pairs of bodies (each by name or index) that never touch.
+fn add_exclusions(obj: &Obj<'_>, world: &mut World) -> Result<()> {
+    let Some(pairs) = obj.get("exclude") else {
+        return Ok(());
+    };
+    for node in pairs.array()? {
+        let ends = node.array()?;
+        let [a, b] = ends.as_slice() else {
+            return Err(node.err(format!(
+                "must be a pair of bodies, got {} items",
+                ends.len()
+            )));
+        };
+        let (a, b) = (body::reference(a, world)?, body::reference(b, world)?);
+        world
+            .exclude_contacts(a, b)
+            .map_err(|e| node.err(e.to_string().replace("exclude: ", "")))?;
     }
     Ok(())
 }

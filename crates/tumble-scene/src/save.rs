@@ -96,6 +96,13 @@ pub fn save_with(world: &World, options: &SaveOptions) -> String {
     top.add("forces", list(&forces, ",\n    "));
     let joints: Vec<String> = world.joints().map(|(_, j)| joint(j, &refs)).collect();
     top.add("joints", list(&joints, ",\n    "));
+    if !world.excluded_contacts().is_empty() {
+        let pairs = world
+            .excluded_contacts()
+            .iter()
+            .map(|&(a, b)| format!("[{}, {}]", refs.of_body(a), refs.of_body(b)));
+        top.add("exclude", inline(pairs));
+    }
     if options.state {
         top.add("state", format!("\"{}\"", hex(&world.snapshot())));
     }

@@ -1,5 +1,5 @@
 //! The checked plan into the world: bodies (compound shapes, the file's mass properties,
-//! collision filters), joints, the contact filter for excluded pairs. A failure removes
+//! collision filters), joints, the excluded pairs (`World::exclude_contacts`). A failure removes
 //! what was created, so the world is left as it was.
 
 use std::collections::BTreeSet;
@@ -79,27 +79,18 @@ fn create_all(plan: &Plan, world: &mut World, made: &mut Made, prefix: &str) -> 
         made.joints.push(id);
         joints.push(id);
     }
-    let mut pairs: Vec<(BodyId, BodyId)> = plan
-        .excluded
-        .iter()
-        .filter_map(|&(a, b)| Some(ordered(bodies[a]?, bodies[b]?)))
-        .collect();
-    pairs.sort_unstable();
-    pairs.dedup();
-    if !pairs.is_empty() {
-        world.set_contact_filter(move |p| {
-            pairs.binary_search(&ordered(p.body_a, p.body_b)).is_err()
-        });
+    // As data, not a contact filter: a second model keeps the first's, and the world can
+    // still be copied (Batch), snapshotted and saved.
+    for &(a, b) in &plan.excluded {
+        if let (Some(a), Some(b)) = (bodies[a], bodies[b]) {
+            if a != b {
+                world
+                    .exclude_contacts(a, b)
+                    .map_err(|e| SceneError::new("contact.exclude", e.to_string()))?;
+            }
+        }
     }
     Ok(Ids { bodies, joints })
-}
-
-fn ordered(a: BodyId, b: BodyId) -> (BodyId, BodyId) {
-    if a <= b {
-        (a, b)
-    } else {
-        (b, a)
-    }
 }
 
 /// The body's mass properties: its parts', or for an intermediate body a thousandth of

@@ -40,7 +40,8 @@ fn misspelt_keys_are_refused_with_the_allowed_ones() {
         "gravityy: unknown key (expected one of: name, description, gravity, dt, duration, \
          integrator, bodies, forces, joints, solver, substeps, iterations, contact_hertz, \
          contact_damping_ratio, joint_hertz, joint_damping_ratio, length_unit, sleep, max_speed, \
-         max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed, character, state, models)"
+         max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed, character, state, models, \
+         exclude)"
     );
     assert_eq!(
         error(&one_body(r#""velocty": [1, 0, 0]"#)),
@@ -338,7 +339,8 @@ fn user_text_cannot_break_the_line() {
         "du\\nration: unknown key (expected one of: name, description, gravity, dt, duration, \
          integrator, bodies, forces, joints, solver, substeps, iterations, contact_hertz, \
          contact_damping_ratio, joint_hertz, joint_damping_ratio, length_unit, sleep, max_speed, \
-         max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed, character, state, models)"
+         max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed, character, state, models, \
+         exclude)"
     );
     assert_eq!(error(r#"{"integrator": "rk\n4"}"#).lines().count(), 1);
     assert_eq!(
@@ -473,4 +475,27 @@ fn sensor_and_one_way_are_checked_with_their_paths() {
     let (_, body) = scene.world.bodies().next().unwrap();
     assert!(body.is_sensor());
     assert_eq!(body.one_way(), Some(tumble::Vec3::Y));
+}
+
+#[test]
+fn bad_exclusions_are_refused_by_entry() {
+    let scene = |exclude: &str| {
+        with_forces("[]").replace("\"forces\": []", &format!("\"exclude\": {exclude}"))
+    };
+    assert_eq!(
+        error(&scene(r#"[["ball", "cup", "ball"]]"#)),
+        "exclude[0]: must be a pair of bodies, got 3 items"
+    );
+    assert_eq!(
+        error(&scene(r#"[["ball", "cup"], ["ball", "mug"]]"#)),
+        "exclude[1][1]: no body named 'mug'"
+    );
+    assert_eq!(
+        error(&scene(r#"[[0, 2]]"#)),
+        "exclude[0][1]: no body at index 2 (there are 2)"
+    );
+    assert_eq!(
+        error(&scene(r#"[["cup", 1]]"#)),
+        "exclude[0]: a body cannot be excluded from itself"
+    );
 }
