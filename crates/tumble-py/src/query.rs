@@ -406,6 +406,42 @@ impl PyWorld {
             .collect()
     }
 
+    /// Keeps bodies `a` and `b` (handles or names) from ever touching, as a joint between
+    /// them does (MuJoCo's `<contact><exclude>`); kept by snapshots, copies, batches and
+    /// saved scenes (the scene key `exclude`).
+    fn exclude_contacts(
+        slf: &Bound<'_, Self>,
+        a: &Bound<'_, PyAny>,
+        b: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
+        let mut g = slf.get().lock()?;
+        let (a, b) = (body_arg(slf, &g, a, "a")?, body_arg(slf, &g, b, "b")?);
+        g.world.exclude_contacts(a, b).map_err(engine)
+    }
+
+    /// Lets an excluded pair touch again; returns whether it was excluded.
+    fn allow_contacts(
+        slf: &Bound<'_, Self>,
+        a: &Bound<'_, PyAny>,
+        b: &Bound<'_, PyAny>,
+    ) -> PyResult<bool> {
+        let mut g = slf.get().lock()?;
+        let (a, b) = (body_arg(slf, &g, a, "a")?, body_arg(slf, &g, b, "b")?);
+        g.world.allow_contacts(a, b).map_err(engine)
+    }
+
+    /// The excluded pairs, each (older body, newer body).
+    #[getter]
+    fn excluded_contacts<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<Vec<(Bound<'py, PyBody>, Bound<'py, PyBody>)>> {
+        let pairs = slf.get().lock()?.world.excluded_contacts().to_vec();
+        pairs
+            .into_iter()
+            .map(|(a, b)| Ok((handle(slf, a)?, handle(slf, b)?)))
+            .collect()
+    }
+
     /// The sensor events of the last step, in (sensor, body) order: bodies that began or
     /// stopped overlapping a sensor. End events of edits made before the step (a body
     /// removed, a sensor flag changed) come first, with the time of the edit.

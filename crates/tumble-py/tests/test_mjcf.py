@@ -542,3 +542,38 @@ def test_condim_is_checked_and_condim_1_is_a_warning(tmp_path):
     path = ball_file(tmp_path, 0.1, 1, "1")
     with pytest.warns(UserWarning, match=r"condim 1 \(frictionless\): not read"):
         tumble.World.from_mjcf(path)
+
+
+def test_a_model_with_excluded_pairs_is_batched_and_snapshotted():
+    # dm_control's humanoid excludes its multi-joint bodies from their parents (and its
+    # file lists <exclude> pairs): as data, these travel with copies, so a Batch of it
+    # steps each copy as the world alone, bit for bit (it was refused: a contact filter).
+    with pytest.warns(UserWarning):
+        world = tumble.World.from_mjcf(SUITE / "humanoid.xml")
+    assert len(world.excluded_contacts) > 0
+    batch = tumble.Batch(world, copies=2, threads=1)
+    twin = tumble.World.from_snapshot(world.snapshot())
+    assert [(a.name, b.name) for a, b in twin.excluded_contacts] == [
+        (a.name, b.name) for a, b in world.excluded_contacts
+    ]
+    batch.step(0.005, steps=100)
+    world.step(0.005, steps=100)
+    assert np.array_equal(batch.positions[1], world.positions)
+
+
+def test_excluded_pairs_from_python():
+    # A small ball dropped on a big one passes through it onto the floor once the pair is
+    # excluded (its centre 0.1 m up, to 5 mm); bad pairs raise ValueError by field.
+    world = tumble.World(gravity=(0, -9.8, 0), sleep=False)
+    world.add_body(tumble.Plane((0, 1, 0)), kind="static")
+    big = world.add_body(tumble.Sphere(0.5), position=(0, 0.5, 0), name="big")
+    small = world.add_body(tumble.Sphere(0.1), position=(0, 2, 0), name="small")
+    world.exclude_contacts("small", big)
+    assert [(a.name, b.name) for a, b in world.excluded_contacts] == [("big", "small")]
+    world.step(0.01, steps=150)
+    assert small.position[1] == pytest.approx(0.1, abs=5e-3)
+    with pytest.raises(ValueError, match="^exclude: a body cannot be excluded from itself$"):
+        world.exclude_contacts(big, big)
+    with pytest.raises(ValueError, match="^b: no body named 'mug'$"):
+        world.exclude_contacts(big, "mug")
+    assert world.allow_contacts(big, small) and not world.allow_contacts(big, small)

@@ -755,6 +755,13 @@ class World:
         """Collision detection on the current state, without a step."""
     def contact_events(self) -> list[ContactEvent]:
         """Pairs that began or ended touching at the last step."""
+    def exclude_contacts(self, a: BodyLike, b: BodyLike) -> None:
+        """Keeps two bodies from ever touching (as a joint between them does); kept by
+        snapshots, batches and saved scenes (scene key `exclude`)."""
+    def allow_contacts(self, a: BodyLike, b: BodyLike) -> bool:
+        """Lets an excluded pair touch again; whether it was excluded."""
+    @property
+    def excluded_contacts(self) -> list[tuple[Body, Body]]: ...
     def sensor_events(self) -> list[SensorEvent]:
         """Bodies that began or stopped overlapping a sensor at the last step, in (sensor, body) order."""
     def sensor_overlaps(self, sensor: BodyLike) -> list[Body]:
