@@ -172,7 +172,7 @@ impl PyJoint {
     }
 
     /// The joint's coordinate, of `body` relative to `other`, zero at creation: hinge
-    /// angle (rad, in (-pi, pi]), slider offset (m), distance (m); a ball or fixed joint's
+    /// angle (rad, counting whole turns), slider offset (m), distance (m); a ball or fixed joint's
     /// rotation vector (rad, in `other`'s frame) as a 3-tuple. Settable (not on fixed
     /// joints): the side of `body` (or of `other`, when `body`'s is held by the world)
     /// moves rigidly to that coordinate, velocities turned with it.

@@ -455,7 +455,7 @@ class Joint:
     def armature(self, value: float) -> None: ...
     @property
     def position(self) -> JointCoordinate:
-        """Hinge angle (rad, in (-pi, pi]), slider offset or distance (m); a ball or fixed
+        """Hinge angle (rad, counting whole turns as MuJoCo's qpos), slider offset or distance (m); a ball or fixed
         joint's rotation vector (rad, in `other`'s frame). Setting it (not on fixed joints)
         moves one side of the joint rigidly to that coordinate."""
     @position.setter

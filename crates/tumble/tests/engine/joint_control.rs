@@ -752,6 +752,7 @@ fn limits_reaching_past_half_a_turn_hold_on_the_far_side() {
 fn a_servo_target_across_half_a_turn_is_reached_the_short_way() {
     // A servo at −3.0 rad sent to +3.0 rad: the short way is 0.28 rad down through −π,
     // not 6 rad back up through zero. Gravity along the hinge, so only the servo acts.
+    // The angle counts whole turns, so it reads 3 − 2π where it stops, not the target.
     for (mass, dt) in [(1.0 as Real, 1.0 / 60.0), (4.0, 1.0 / 120.0)] {
         let mut w = awake(Vec3::new(0.0, -G, 0.0));
         let door = slab(
@@ -778,8 +779,9 @@ fn a_servo_target_across_half_a_turn_is_reached_the_short_way() {
         }
         // The short way is the negative one: the door never turns the positive way.
         assert!(highest < 1e-3, "turned the long way, at {highest} rad/s");
+        let below = 3.0 - 2.0 * std::f64::consts::PI as Real;
         assert!(
-            (angle(&w, j) - 3.0).abs() < 0.01,
+            (angle(&w, j) - below).abs() < 0.01,
             "ends at {}",
             angle(&w, j)
         );
@@ -890,4 +892,60 @@ fn a_spring_set_at_run_time_acts_and_a_removed_one_stops() {
             "dt {dt}: {v} -> {after}"
         );
     }
+}
+
+#[test]
+fn a_hinge_angle_counts_whole_turns() {
+    // A wheel (a bar turning about y through its centre, gravity along the axis) driven
+    // by a stiff motor at ω: its angle grows as ω t past any number of turns, as MuJoCo's
+    // qpos does, also at 4 rad a step (40 rad/s at dt 0.1: more than half a turn a step),
+    // to a step's turn (the motor reaches ω within the first substep). Set to 4π + 0.5 it
+    // reads that back, and a snapshot restored reads what the original reads.
+    for (omega, dt) in [
+        (10.0 as Real, 1.0 as Real / 60.0),
+        (-100.0, 1.0 / 60.0),
+        (40.0, 1.0 / 10.0),
+    ] {
+        let mut w = awake(Vec3::new(0.0, -G, 0.0));
+        let wheel = slab(
+            &mut w,
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(1.0, 0.1, 0.2),
+            1.0,
+        );
+        let j = hinge_to_world(&mut w, wheel, Vec3::ZERO, Vec3::Y);
+        let motor = Motor {
+            speed: omega,
+            max_force: 1e6,
+        };
+        w.set_joint_motor(j, Some(motor)).unwrap();
+        let steps = (3.0 / dt).round() as usize;
+        run(&mut w, dt, steps);
+        let expected = omega * steps as Real * dt;
+        let got = angle(&w, j);
+        assert!(
+            (got - expected).abs() < omega.abs() * dt,
+            "ω {omega}: {got} rad after {} s, expected {expected}",
+            steps as Real * dt
+        );
+        let copy = World::from_snapshot(&w.snapshot()).unwrap();
+        assert_eq!(scalar(copy.joint_position(j).unwrap()), got);
+    }
+    let mut w = awake(Vec3::ZERO);
+    let wheel = slab(
+        &mut w,
+        Vec3::new(0.5, 1.0, 0.0),
+        Vec3::new(1.0, 0.1, 0.2),
+        1.0,
+    );
+    let j = hinge_to_world(&mut w, wheel, Vec3::new(-0.5, 0.0, 0.0), Vec3::Y);
+    let q = 4.0 * std::f64::consts::PI as Real + 0.5;
+    w.set_joint_position(j, JointCoordinate::Scalar(q)).unwrap();
+    assert_eq!(angle(&w, j), q);
+    w.step(1.0 / 60.0).unwrap();
+    assert!(
+        (angle(&w, j) - q).abs() < tol(1e-9, 1e-5),
+        "{}",
+        angle(&w, j)
+    );
 }

@@ -4,9 +4,12 @@
 //! relative to `other`:
 //!
 //! ```text
-//! hinge     angle about the axis (rad), zero at creation, read in the turn about the middle
-//!           of its limits (else its servo's target, its spring's rest, or 0: (−π, π]; see
-//!           `angle_window`); rate axis·(ω_a − ω_b)
+//! hinge     angle about the axis (rad), zero at creation, counting whole turns: read in
+//!           the turn about the angle after the last step (`Joint::angle`, followed at
+//!           every step), as MuJoCo's qpos; rate axis·(ω_a − ω_b). The solver reads it in
+//!           the turn about the middle of its limits (else its servo's target, its
+//!           spring's rest, or 0: (−π, π]; see `angle_window`), so a servo takes the
+//!           short way to its target and a wheel's limits-free angle may grow without end
 //! slider    axis·(p_a − p_b) (m): the anchors' offset along the axis (zero at creation
 //!           when the anchors coincide then, as the scene format and Python's defaults
 //!           make them); its rate
@@ -82,12 +85,16 @@ fn anchors(joint: &Joint, a: &BodyMotion, b: &BodyMotion) -> (Vec3, Vec3, Vec3) 
     (pa, pb, pb - pa)
 }
 
-/// The hinge angle of `body` about its axis relative to `other` (rad), in the joint's
-/// window (see [`angle_window`]).
-pub(crate) fn hinge_angle(joint: &Joint, qa: Quat, qb: Quat) -> Real {
+/// The hinge angle of `body` about its axis relative to `other` (rad), in (−π, π].
+pub(crate) fn raw_hinge_angle(joint: &Joint, qa: Quat, qb: Quat) -> Real {
     let axis = qa * joint.axis;
     let (ra, rb) = (qa * joint.reference, qb * joint.other_reference);
-    let angle = axis.dot(rb.cross(ra)).atan2(ra.dot(rb));
+    axis.dot(rb.cross(ra)).atan2(ra.dot(rb))
+}
+
+/// The hinge angle as the solver reads it: in the joint's window (see [`angle_window`]).
+pub(crate) fn hinge_angle(joint: &Joint, qa: Quat, qb: Quat) -> Real {
+    let angle = raw_hinge_angle(joint, qa, qb);
     let o = joint.def.kind.options();
     in_window(
         angle,
@@ -151,7 +158,9 @@ pub(crate) fn rotation_vector(q: Quat) -> Vec3 {
 pub(crate) fn position(joint: &Joint, a: &BodyMotion, b: &BodyMotion) -> JointCoordinate {
     let (_, _, d) = anchors(joint, a, b);
     match joint.def.kind.spec().free {
-        Some(FreeAxis::Rotation) => JointCoordinate::Scalar(hinge_angle(joint, a.q, b.q)),
+        Some(FreeAxis::Rotation) => {
+            JointCoordinate::Scalar(in_window(raw_hinge_angle(joint, a.q, b.q), joint.angle))
+        }
         Some(FreeAxis::Translation) => JointCoordinate::Scalar(-(a.q * joint.axis).dot(d)),
         Some(FreeAxis::Distance) => JointCoordinate::Scalar(d.length()),
         _ => JointCoordinate::Vector(rotation_vector(relative_rotation(joint, a.q, b.q))),

@@ -202,6 +202,10 @@ pub struct Joint {
     pub(crate) reaction_torque: Vec3,
     /// Impulses of the last substep, to warm-start the next.
     pub(crate) impulses: JointImpulses,
+    /// A hinge's angle as last read (rad): at creation, after every step and when set.
+    /// Its reading counts whole turns from here (`coords::position`), as MuJoCo's qpos
+    /// and PyBullet's joint states do; 0 for other kinds.
+    pub(crate) angle: Real,
 }
 
 /// Accumulated impulses of a joint's rows.
@@ -390,7 +394,7 @@ pub(crate) fn build(def: &JointDef, body: (Vec3, Quat), other: Option<(Vec3, Qua
         Some(l) => l,
         None => (world_b - world_a).length(),
     };
-    Joint {
+    let mut joint = Joint {
         def: def.clone(),
         axis,
         other_axis,
@@ -403,7 +407,13 @@ pub(crate) fn build(def: &JointDef, body: (Vec3, Quat), other: Option<(Vec3, Qua
         reaction_force: Vec3::ZERO,
         reaction_torque: Vec3::ZERO,
         impulses: JointImpulses::default(),
+        angle: 0.0,
+    };
+    if joint.def.kind.spec().free == Some(FreeAxis::Rotation) {
+        // Zero unless the limits' window lies elsewhere (see `coords::angle_window`).
+        joint.angle = coords::hinge_angle(&joint, qa, qb);
     }
+    joint
 }
 
 crate::codec::codec_struct!(Motor { speed, max_force });
@@ -443,7 +453,8 @@ crate::codec::codec_struct!(Joint {
     enabled,
     reaction_force,
     reaction_torque,
-    impulses
+    impulses,
+    angle
 });
 crate::codec::codec_struct!(JointImpulses {
     hard,

@@ -55,7 +55,7 @@ impl Rigid {
 }
 
 impl World {
-    /// The joint's coordinate: hinge angle (rad, in (−π, π]), slider offset (m),
+    /// The joint's coordinate: hinge angle (rad, counting whole turns), slider offset (m),
     /// distance (m), or a ball or fixed joint's rotation vector (rad, in `other`'s frame);
     /// see `tumble::joint::JointCoordinate`.
     pub fn joint_position(&self, id: JointId) -> Result<JointCoordinate> {
@@ -68,6 +68,27 @@ impl World {
     pub fn joint_velocity(&self, id: JointId) -> Result<JointCoordinate> {
         let (joint, a, b) = self.joint_motions(id)?;
         Ok(coords::velocity(joint, &a, &b))
+    }
+
+    /// Follows each hinge's angle through the step just taken (see `Joint::angle`): read
+    /// in the turn about where it was plus its rate times the step, so that it counts
+    /// whole turns even for a wheel turning more than half a turn a step.
+    pub(super) fn follow_hinge_angles(&mut self, dt: Real) {
+        for k in 0..self.joints.list.len() {
+            let joint = &self.joints.list[k];
+            if joint.def.kind.spec().free != Some(FreeAxis::Rotation) {
+                continue;
+            }
+            let motion = |body: Option<crate::id::BodyId>| match body.and_then(|b| self.dense(b)) {
+                Some(i) => self.motion_of(i),
+                None => BodyMotion::WORLD,
+            };
+            let (a, b) = (motion(Some(joint.def.body)), motion(joint.def.other));
+            let rate = (a.q * joint.axis).dot(a.w - b.w);
+            let raw = coords::raw_hinge_angle(joint, a.q, b.q);
+            let angle = coords::in_window(raw, joint.angle + rate * dt);
+            self.joints.list[k].angle = angle;
+        }
     }
 
     fn joint_motions(&self, id: JointId) -> Result<(&Joint, BodyMotion, BodyMotion)> {
@@ -96,8 +117,8 @@ impl World {
     /// joint, a broken or disabled one, a coordinate of the wrong shape or out of range
     /// (`position: must be > 0` for a distance), when both sides are anchored or joined
     /// by another path (a closed loop), or when a body would leave the world's range or
-    /// its plane. Wakes every body it moves. A hinge angle is read back in (−π, π]: a
-    /// `q` outside it poses the same angle, turning the short way.
+    /// its plane. Wakes every body it moves. A hinge is turned the short way to `q`'s
+    /// pose, and reads `q` back, whole turns included (as MuJoCo's qpos).
     pub fn set_joint_position(&mut self, id: JointId, q: JointCoordinate) -> Result<()> {
         let k = self.joints.handles.dense(id).ok_or_else(|| unknown(id))?;
         let joint = &self.joints.list[k];
@@ -105,6 +126,10 @@ impl World {
         let (moving, body_side) = self.moving_side(k)?;
         let (_, a, b) = self.joint_motions(id)?;
         let motion = solve_motion(joint, q, a, b, body_side);
+        let angle = match (joint.def.kind.spec().free, q) {
+            (Some(FreeAxis::Rotation), JointCoordinate::Scalar(q)) => q,
+            _ => joint.angle,
+        };
         let moved: Vec<(usize, BodyMotion)> = moving
             .iter()
             .map(|&i| (i, motion.apply(&self.motion_of(i))))
@@ -132,6 +157,7 @@ impl World {
             c.broad_phase.update(c.proxies[i], aabb, Vec3::ZERO);
             self.wake_around(i);
         }
+        self.joints.list[k].angle = angle;
         self.wake_joint(k);
         Ok(())
     }

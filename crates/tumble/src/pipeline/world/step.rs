@@ -128,6 +128,7 @@ impl World {
         self.sweep_fast();
         self.check_result(&time)?;
         self.scatter();
+        self.follow_hinge_angles(dt);
         self.update_sleep(&time);
         self.clock.time += dt;
         self.clock.steps += 1;
