@@ -158,13 +158,6 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
             .set_threads(n)
             .map_err(|e| Failure::Input(e.to_string()))?;
     }
-    if args.save_state.is_some() && scene.character.is_some() {
-        return Err(Failure::Input(
-            "save-state: a scene with a character cannot be saved yet (its path and fall \
-             are not world state)"
-                .into(),
-        ));
-    }
     let plan = args.span.plan(&scene)?;
     let times = Times::new(plan, scene.world.step_count());
     let mut sinks = Sinks::open(args, &scene, &plan)?;
@@ -267,6 +260,7 @@ fn save_state(target: Target, scene: &Scene, plan: &RunPlan, quiet: bool) -> Res
         duration: plan.end_time,
         colors: scene.body_colors.clone(),
         state: true,
+        character: scene.character.clone(),
     };
     let text = tumble_scene::save_with(&scene.world, &options);
     let shown = target.shown().to_string();

@@ -14,7 +14,7 @@ use tumble::{
 use crate::error::{Result, SceneError};
 use crate::reader::{Node, Obj};
 
-const CHARACTER_KEYS: [&str; 13] = [
+const CHARACTER_KEYS: [&str; 16] = [
     "name",
     "position",
     "radius",
@@ -28,7 +28,12 @@ const CHARACTER_KEYS: [&str; 13] = [
     "collision_mask",
     "color",
     "path",
+    "fall",
+    "velocity",
+    "ground",
 ];
+
+const GROUND_KEYS: [&str; 3] = ["body", "normal", "point"];
 
 const LEG_KEYS: [&str; 2] = ["until", "velocity"];
 
@@ -122,6 +127,35 @@ pub(crate) fn character(
         fall: Vec3::ZERO,
     };
     Ok((walker, name, color))
+}
+
+/// Where a saved run left the character (a saved scene's `fall`, `velocity` and
+/// `ground`), applied once the world is whole (its `state` restored), so that the ground
+/// body is the restored world's. `ground: null` is in the air; without `ground` the
+/// ground found at `position` is kept.
+pub(crate) fn resume(node: &Node<'_>, walker: &mut Walker, world: &World) -> Result<()> {
+    let obj = node.object()?;
+    if let Some(fall) = obj.vec3("fall")? {
+        walker.fall = fall;
+    }
+    let velocity = obj.vec3("velocity")?;
+    let ground = match obj.get("ground") {
+        None => walker.controller.ground(),
+        Some(g) if g.is_null() => None,
+        Some(g) => {
+            let o = g.object()?;
+            o.only(&GROUND_KEYS)?;
+            Some(tumble::Ground {
+                body: crate::body::reference(&o.required("body")?, world)?,
+                normal: o.required("normal")?.vec3()?,
+                point: o.required("point")?.vec3()?,
+            })
+        }
+    };
+    let c = &mut walker.controller;
+    let (position, velocity) = (c.position(), velocity.unwrap_or(c.velocity()));
+    c.restore(world, position, ground, velocity)
+        .map_err(|e| SceneError::from_engine(e, node.path()))
 }
 
 /// The controller's settings: each key as `CharacterDef`'s field, the engine's default

@@ -263,7 +263,7 @@ fn build(root: &Node<'_>, dir: &Path) -> Result<Scene> {
     add_forces(&obj, &mut world)?;
     add_joints(&obj, &mut world)?;
     add_exclusions(&obj, &mut world)?;
-    let character = match obj.get("character") {
+    let mut character = match obj.get("character") {
         Some(node) => {
             let (walker, label, color) = character::character(&node, &mut world)?;
             body_names.push(label);
@@ -274,6 +274,9 @@ fn build(root: &Node<'_>, dir: &Path) -> Result<Scene> {
     };
     if let Some(node) = obj.get("state") {
         restore_state(&node, &mut world, body_names.len())?;
+    }
+    if let (Some(walker), Some(node)) = (character.as_mut(), obj.get("character")) {
+        character::resume(&node, walker, &world)?;
     }
     check_number_names(&world)?;
     Ok(Scene {

@@ -17,7 +17,7 @@ use std::fmt::Write;
 use tumble::joint::OptionValue;
 use tumble::{Body, BodyId, BodyKind, Force, Joint, Quat, Real, Shape, SpringEnd, Vec3, World};
 
-use crate::Scene;
+use crate::{Scene, Walker};
 
 /// What `save_with` writes besides the world.
 #[derive(Debug, Clone, PartialEq)]
@@ -34,6 +34,12 @@ pub struct SaveOptions {
     pub colors: Vec<Option<[u8; 3]>>,
     /// Whether to write the `"state"` section (the world's snapshot).
     pub state: bool,
+    /// The scene's character, written as its `character` object (settings, path, and
+    /// where it is: position, fall, last velocity and ground), its body then left out of
+    /// `bodies` (the character makes it again, as the last body, when loaded). Written
+    /// only while its body is the world's last, as a scene makes it; otherwise the body
+    /// is written as a plain kinematic body.
+    pub character: Option<Walker>,
 }
 
 impl Default for SaveOptions {
@@ -45,6 +51,7 @@ impl Default for SaveOptions {
             duration: crate::DEFAULT_DURATION,
             colors: Vec::new(),
             state: true,
+            character: None,
         }
     }
 }
@@ -55,8 +62,7 @@ pub fn save(world: &World) -> String {
 }
 
 /// A loaded scene's world as scene JSON with its `"state"`, keeping the scene's name,
-/// description, `dt`, `duration` and colours. A scene's character (its path and fall)
-/// is not world state and is not written: its body is, as a plain kinematic body.
+/// description, `dt`, `duration`, colours and character.
 pub fn save_scene(scene: &Scene) -> String {
     save_with(
         &scene.world,
@@ -67,6 +73,7 @@ pub fn save_scene(scene: &Scene) -> String {
             duration: scene.duration,
             colors: scene.body_colors.clone(),
             state: true,
+            character: scene.character.clone(),
         },
     )
 }
@@ -82,10 +89,15 @@ pub fn save_with(world: &World, options: &SaveOptions) -> String {
     }
     settings(world, options, &mut top);
     let refs = References::of(world);
+    let walker = options
+        .character
+        .as_ref()
+        .filter(|w| world.body_ids().last() == Some(&w.body));
     let bodies: Vec<String> = world
         .body_ids()
         .iter()
         .enumerate()
+        .filter(|&(_, &id)| walker.is_none_or(|w| w.body != id))
         .map(|(i, &id)| {
             let color = options.colors.get(i).copied().flatten();
             body(world.body(id).expect("a live body"), color)
@@ -96,6 +108,14 @@ pub fn save_with(world: &World, options: &SaveOptions) -> String {
     top.add("forces", list(&forces, ",\n    "));
     let joints: Vec<String> = world.joints().map(|(_, j)| joint(j, &refs)).collect();
     top.add("joints", list(&joints, ",\n    "));
+    if let Some(w) = walker {
+        let color = options
+            .colors
+            .get(world.body_count() - 1)
+            .copied()
+            .flatten();
+        top.add("character", character(w, world, &refs, color));
+    }
     if !world.excluded_contacts().is_empty() {
         let pairs = world
             .excluded_contacts()
@@ -270,6 +290,53 @@ fn body(b: &Body, color: Option<[u8; 3]>) -> String {
     if let Some([r, g, b]) = color {
         f.add("color", format!("\"#{r:02x}{g:02x}{b:02x}\""));
     }
+    f.object()
+}
+
+/// The `character` object of `w` (see `crate::character` for its keys).
+fn character(w: &Walker, world: &World, refs: &References, color: Option<[u8; 3]>) -> String {
+    let c = &w.controller;
+    let d = c.def();
+    let mut f = Fields::default();
+    if let Some(n) = world.body(w.body).ok().and_then(|b| b.name()) {
+        f.add("name", text(n));
+    }
+    f.add("position", vec3(c.position()));
+    for (key, x) in [
+        ("radius", d.radius),
+        ("half_height", d.half_height),
+        ("max_slope", d.max_slope),
+        ("step_height", d.step_height),
+        ("skin", d.skin),
+        ("snap_distance", d.snap_distance),
+        ("max_push_force", d.max_push_force),
+    ] {
+        f.add(key, num(x));
+    }
+    f.add("up", vec3(d.up));
+    f.add("collision_mask", d.filter.mask.to_string());
+    if let Some([r, g, b]) = color {
+        f.add("color", format!("\"#{r:02x}{g:02x}{b:02x}\""));
+    }
+    let legs = w.path.iter().map(|leg| {
+        format!(
+            "{{\"until\": {}, \"velocity\": {}}}",
+            num(leg.until),
+            vec3(leg.velocity)
+        )
+    });
+    f.add("path", inline(legs));
+    f.add("fall", vec3(w.fall));
+    f.add("velocity", vec3(c.velocity()));
+    let ground = c.ground().map_or("null".to_string(), |g| {
+        format!(
+            "{{\"body\": {}, \"normal\": {}, \"point\": {}}}",
+            refs.of_body(g.body),
+            vec3(g.normal),
+            vec3(g.point)
+        )
+    });
+    f.add("ground", ground);
     f.object()
 }
 

@@ -214,7 +214,7 @@ fn bad_character_fields_are_refused_with_their_path() {
             r#"{"radiuss": 1}"#,
             "character.radiuss: unknown key (expected one of: name, position, radius, \
              half_height, up, max_slope, step_height, skin, snap_distance, max_push_force, \
-             collision_mask, color, path)",
+             collision_mask, color, path, fall, velocity, ground)",
         ),
         (r#"{"path": {}}"#, "character.path: expected an array"),
         (

@@ -499,3 +499,36 @@ fn bad_exclusions_are_refused_by_entry() {
         "exclude[0]: a body cannot be excluded from itself"
     );
 }
+
+#[test]
+fn a_bad_saved_character_state_is_refused_by_field() {
+    let scene = |state: &str| {
+        format!(
+            r#"{{"bodies": [{{"name": "floor", "kind": "static",
+                   "shape": {{"type": "plane", "normal": [0, 1, 0]}}}}],
+                 "character": {{"position": [0, 0.92, 0], {state}}}}}"#
+        )
+    };
+    assert_eq!(
+        error(&scene(
+            r#""ground": {"body": "roof", "normal": [0, 1, 0], "point": [0, 0, 0]}"#
+        )),
+        "character.ground.body: no body named 'roof'"
+    );
+    assert_eq!(
+        error(&scene(
+            r#""ground": {"body": "floor", "normal": [0, 2, 0], "point": [0, 0, 0]}"#
+        )),
+        "character.ground.normal: must be a unit vector"
+    );
+    assert_eq!(
+        error(&scene(
+            r#""ground": {"body": "floor", "normal": [0, 1, 0]}"#
+        )),
+        "character.ground.point: missing required key"
+    );
+    assert_eq!(
+        error(&scene(r#""fall": [0, "down", 0]"#)),
+        "character.fall[1]: expected a number"
+    );
+}

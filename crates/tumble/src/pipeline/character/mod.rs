@@ -198,6 +198,34 @@ impl CharacterController {
         Ok(())
     }
 
+    /// Puts the character back where a saved run left it: at `position`, on `ground` (or
+    /// in the air with `None`), its last move's `velocity`; the next move then goes on as
+    /// it would have (a move reads only where it is and whether it is on the ground).
+    /// Refused, changing nothing, for a position beyond the world's range, a velocity or
+    /// ground that is not finite, a ground normal that is not a unit vector, or a ground
+    /// body the world does not hold.
+    pub fn restore(
+        &mut self,
+        world: &World,
+        position: Vec3,
+        ground: Option<Ground>,
+        velocity: Vec3,
+    ) -> Result<()> {
+        check::vec3_at_most("position", position, MAX_COORDINATE, "m")?;
+        check::vec3("velocity", velocity)?;
+        if let Some(g) = ground {
+            world.body(g.body).map_err(|e| e.within("ground"))?;
+            check::vec3("ground.point", g.point)?;
+            check::vec3("ground.normal", g.normal)?;
+            if (g.normal.length() - 1.0).abs() > 1e-3 {
+                return Err(Error::invalid("ground.normal", "must be a unit vector"));
+            }
+        }
+        (self.position, self.ground, self.velocity) = (position, ground, velocity);
+        self.pushes.clear();
+        Ok(())
+    }
+
     /// The capsule's pose: its centre, and the rotation taking y to `up`.
     pub fn pose(&self) -> Pose {
         self.capsule.pose(self.position)
