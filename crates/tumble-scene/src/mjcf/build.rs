@@ -222,7 +222,16 @@ fn read_options(root: &Elem, defaults: &Defaults, warn: &mut Warnings) -> Result
                 ))
             }
         };
-        for key in ["density", "viscosity", "wind", "magnetic", "o_margin"] {
+        for key in [
+            "density",
+            "viscosity",
+            "wind",
+            "magnetic",
+            "o_margin",
+            "cone",
+            "impratio",
+            "noslip_iterations",
+        ] {
             if v.get(key).is_some() {
                 warn.add(o, &format!("option {key}: not read"));
             }
@@ -415,6 +424,18 @@ fn child_body(
     let v = View::new(elem, class, defaults)?;
     let pose = compose(parent_pose, frame::frame(&v, &ctx.compiler)?);
     let child_class = child_class(elem, &v, defaults, class)?;
+    // A mocap body is moved by MuJoCo's mocap_pos (here: static, as welded to the world);
+    // gravity compensation has nothing to map to.
+    if elem.own("mocap") == Some("true") {
+        ctx.warn
+            .add(elem, "body mocap: not read (the body stays where it is)");
+    }
+    if elem
+        .own("gravcomp")
+        .is_some_and(|g| g.trim().parse::<f64>() != Ok(0.0))
+    {
+        ctx.warn.add(elem, "body gravcomp: not read");
+    }
     let joints: Vec<&Elem> = elem
         .children
         .iter()
@@ -705,6 +726,12 @@ fn actuator(ctx: &mut Ctx<'_>, a: &Elem, index: usize) -> Result<Option<PlanActu
     if ctx.joints[joint].kind == "ball" {
         ctx.warn.add(a, "actuators on ball joints: not read");
         return Ok(None);
+    }
+    for key in ["timeconst", "dampratio"] {
+        if a.tag == "position" && v.get(key).is_some() {
+            ctx.warn
+                .add(a, &format!("position actuator {key}: not read"));
+        }
     }
     let gear = v.reals("gear", &[1, 2, 3, 4, 5, 6])?.map_or(1.0, |g| g[0]);
     let (gain, damping) = match a.tag.as_str() {

@@ -1066,3 +1066,34 @@ fn excluded_pairs_hold_in_every_copy_of_a_model_and_the_world_can_be_batched() {
     }
     assert_eq!(batch.world(0).unwrap().state_hash(), world.state_hash());
 }
+
+#[test]
+fn options_bodies_and_actuators_with_nothing_to_map_to_are_warned() {
+    let text = "<mujoco>\n<option cone=\"elliptic\" impratio=\"10\"/>\n<worldbody>\n\
+                <body name=\"target\" mocap=\"true\"><geom size=\"0.1\"/></body>\n\
+                <body name=\"arm\" gravcomp=\"1\"><joint name=\"j\"/><geom size=\"0.1\"/></body>\n\
+                <body name=\"idle\" gravcomp=\"0\"><joint/><geom size=\"0.1\"/></body>\n\
+                </worldbody>\n<actuator><position joint=\"j\" kp=\"5\" dampratio=\"1\"/></actuator>\n\
+                </mujoco>";
+    let mut world = z_up();
+    let m = mjcf::load(
+        write("unmapped.xml", text),
+        &mut world,
+        &MjcfOptions::default(),
+    )
+    .unwrap();
+    let lines: Vec<String> = m.warnings.iter().map(|w| w.to_string()).collect();
+    for expected in [
+        "unmapped.xml:2: <option>: option cone: not read",
+        "unmapped.xml:2: <option>: option impratio: not read",
+        "unmapped.xml:4: <body name=\"target\">: body mocap: not read (the body stays where it is)",
+        "unmapped.xml:5: <body name=\"arm\">: body gravcomp: not read",
+        "unmapped.xml:8: <position>: position actuator dampratio: not read",
+    ] {
+        assert!(
+            lines.contains(&expected.to_string()),
+            "{expected}: {lines:?}"
+        );
+    }
+    assert_eq!(lines.len(), 5, "{lines:?}");
+}
