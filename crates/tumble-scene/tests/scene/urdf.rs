@@ -630,6 +630,14 @@ fn bad_files_are_refused_with_file_line_and_element_and_change_nothing() {
     );
     refused(
         &d,
+        "moment.urdf",
+        &link(
+            "<inertial><mass value=\"1\"/><inertia ixx=\"1\" iyy=\"-0.5\" izz=\"1\"/></inertial>",
+        ),
+        "moment.urdf:2: <link name=\"a\">: inertial.inertia.iyy: must be >= 0, got -0.5",
+    );
+    refused(
+        &d,
         "missing.urdf",
         &link("<collision>\n<geometry><mesh filename=\"meshes/gone.stl\"/></geometry></collision>"),
         "missing.urdf:4: <mesh>: filename: mesh file 'meshes/gone.stl' not found",
