@@ -91,6 +91,8 @@ impl PyWorld {
     #[staticmethod]
     #[pyo3(signature = (path, *, fixed_base = true, gravity = None, position = None,
         orientation = None, merge_fixed = true, self_collision = false))]
+    // The keyword arguments of a Python constructor, and the interpreter for its warnings.
+    #[allow(clippy::too_many_arguments)]
     fn from_urdf(
         py: Python<'_>,
         path: std::path::PathBuf,
