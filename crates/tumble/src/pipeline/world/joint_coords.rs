@@ -79,11 +79,7 @@ impl World {
             if joint.def.kind.spec().free != Some(FreeAxis::Rotation) {
                 continue;
             }
-            let motion = |body: Option<crate::id::BodyId>| match body.and_then(|b| self.dense(b)) {
-                Some(i) => self.motion_of(i),
-                None => BodyMotion::WORLD,
-            };
-            let (a, b) = (motion(Some(joint.def.body)), motion(joint.def.other));
+            let (a, b) = self.motions_of(joint);
             let rate = (a.q * joint.axis).dot(a.w - b.w);
             let raw = coords::raw_hinge_angle(joint, a.q, b.q);
             let angle = coords::in_window(raw, joint.angle + rate * dt);
@@ -93,11 +89,17 @@ impl World {
 
     fn joint_motions(&self, id: JointId) -> Result<(&Joint, BodyMotion, BodyMotion)> {
         let joint = self.joint(id)?;
+        let (a, b) = self.motions_of(joint);
+        Ok((joint, a, b))
+    }
+
+    /// The motions of the joint's two bodies (the world's for none).
+    fn motions_of(&self, joint: &Joint) -> (BodyMotion, BodyMotion) {
         let motion = |body: Option<crate::id::BodyId>| match body.and_then(|b| self.dense(b)) {
             Some(i) => self.motion_of(i),
             None => BodyMotion::WORLD,
         };
-        Ok((joint, motion(Some(joint.def.body)), motion(joint.def.other)))
+        (motion(Some(joint.def.body)), motion(joint.def.other))
     }
 
     fn motion_of(&self, i: usize) -> BodyMotion {
