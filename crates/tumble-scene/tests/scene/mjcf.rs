@@ -1097,3 +1097,62 @@ fn options_bodies_and_actuators_with_nothing_to_map_to_are_warned() {
     }
     assert_eq!(lines.len(), 5, "{lines:?}");
 }
+
+/// `<option integrator>` maps to the nearest Tumble integrator; `<compiler settotalmass>`
+/// scales every moving body to the total, keeping their ratios; an ellipsoid has its exact
+/// mass and inertia (m = ρ 4/3 π abc, I_x = m (b² + c²)/5, ...); a slide's `ref` and
+/// `springref` put its spring's rest at springref − ref in Tumble's coordinate (zero at
+/// the file's placement), where the damped slide settles (to 1e-3 m: 10 s of a decay
+/// e^(−ζωt) with ζω ≈ 0.78/s from 0.3 m).
+#[test]
+fn integrator_total_mass_ellipsoids_and_spring_references_are_read() {
+    let text = |integrator: &str| {
+        format!(
+            r#"<mujoco><compiler settotalmass="6"/>
+             <option integrator="{integrator}" gravity="0 0 0"/>
+             <worldbody>
+               <body name="egg" pos="0 0 1">
+                 <joint name="s" type="slide" axis="1 0 0" ref="0.2" springref="0.5"
+                        stiffness="40" damping="8"/>
+                 <geom type="ellipsoid" size="0.1 0.2 0.3"/></body>
+               <body name="ball" pos="2 0 1"><freejoint/><geom type="sphere" size="0.1"/></body>
+             </worldbody></mujoco>"#
+        )
+    };
+    for (name, expected) in [
+        ("RK4", tumble::Integrator::Rk4),
+        ("implicitfast", tumble::Integrator::ImplicitEuler),
+        ("Euler", tumble::Integrator::SymplecticEuler),
+    ] {
+        let (world, _) = load_at(write(&format!("options_{name}.xml"), &text(name)));
+        assert_eq!(world.integrator(), expected, "{name}");
+    }
+    let (mut world, m) = load_at(write("options_RK4.xml", &text("RK4")));
+    let egg = world.body(m.body("egg").unwrap()).unwrap();
+    let ball = world.body(m.body("ball").unwrap()).unwrap();
+    // Volumes 0.1·0.2·0.3 and 0.1³ (times 4/3 π): the egg is six balls.
+    assert!(close(egg.mass() + ball.mass(), 6.0, EXACT));
+    assert!(close(egg.mass(), 6.0 * ball.mass(), EXACT));
+    let me = egg.mass();
+    let expected = Mat3::from_diagonal(Vec3::new(
+        me * (0.04 + 0.09) / 5.0,
+        me * (0.01 + 0.09) / 5.0,
+        me * (0.01 + 0.04) / 5.0,
+    ));
+    assert!(
+        mat_close(egg.inertia_local(), expected, 1e-6),
+        "{}",
+        egg.inertia_local()
+    );
+    let s = m.joint("s").unwrap();
+    assert_eq!(s.reference, 0.2);
+    assert!(close(s.spring.1, 0.3, EXACT) && s.spring.0 == 40.0 && s.spring.2 == 8.0);
+    let id = s.id.unwrap();
+    // Awake throughout: its last centimetres of swing are slower than the sleep speed.
+    world.set_sleep_enabled(false);
+    for _ in 0..5000 {
+        world.step(0.002).unwrap();
+    }
+    let q = world.joint_position(id).unwrap().scalar().unwrap();
+    assert!((q - 0.3).abs() < 1e-3, "settled at {q}");
+}
