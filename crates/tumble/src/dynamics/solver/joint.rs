@@ -20,7 +20,7 @@
 //!
 //! (ball, hinge and fixed lock the point; a slider locks across its axis; a hinge locks
 //! across its axis angularly; fixed and slider lock all rotation), solved together,
-//! K = J M⁻¹ Jᵀ (up to 6×6) by Gaussian elimination. Solving the point and the lock one
+//! K = J M⁻¹ Jᵀ (up to 6×6) factored as L D Lᵀ. Solving the point and the lock one
 //! after the other instead leaves them fighting: a slider's across rows push at the
 //! anchor's lever arm and turn the body, the lock turns it back, and the body drifted 4 cm
 //! off a tilted axis in a second. A point lock with no angular lock (a ball joint) has no
@@ -55,12 +55,12 @@ use one_d::{free_impulse, solve_free, solve_limit, FreeDrive, Line};
 /// The solver's hard blocks of the joints, by `JointConstraint::block`: a slice when one
 /// thread has them all, [`SharedBlocks`] when a joint colour is split over threads.
 pub(crate) trait BlockSlots {
-    fn slot(&mut self, i: usize) -> &mut Option<Block>;
+    fn slot(&mut self, i: usize) -> &mut Block;
 }
 
-impl BlockSlots for [Option<Block>] {
+impl BlockSlots for [Block] {
     #[inline(always)]
-    fn slot(&mut self, i: usize) -> &mut Option<Block> {
+    fn slot(&mut self, i: usize) -> &mut Block {
         &mut self[i]
     }
 }
@@ -68,7 +68,7 @@ impl BlockSlots for [Option<Block>] {
 /// The blocks seen by the pieces of a joint colour at once, through the team's
 /// [`Parts`], each piece reaching the slots of its own joints only.
 #[derive(Clone, Copy)]
-pub(crate) struct SharedBlocks<'p, 'a>(&'p Parts<'a, Option<Block>>);
+pub(crate) struct SharedBlocks<'p, 'a>(&'p Parts<'a, Block>);
 
 impl<'p, 'a> SharedBlocks<'p, 'a> {
     /// Shares the blocks in `parts` between the pieces of a job.
@@ -77,14 +77,14 @@ impl<'p, 'a> SharedBlocks<'p, 'a> {
     /// While copies of the result are used on several threads at once, each slot must be
     /// reached through one copy only. A slot belongs to one joint (`prepare_joints` numbers
     /// them), and a joint to one piece.
-    pub unsafe fn new(parts: &'p Parts<'a, Option<Block>>) -> SharedBlocks<'p, 'a> {
+    pub unsafe fn new(parts: &'p Parts<'a, Block>) -> SharedBlocks<'p, 'a> {
         SharedBlocks(parts)
     }
 }
 
 impl BlockSlots for SharedBlocks<'_, '_> {
     #[inline(always)]
-    fn slot(&mut self, i: usize) -> &mut Option<Block> {
+    fn slot(&mut self, i: usize) -> &mut Block {
         // SAFETY: by `new`'s contract slot `i` is reached through this copy alone, so no
         // other live slice covers it (`part` checks the bounds).
         unsafe { &mut self.0.part(i..i + 1)[0] }
@@ -141,6 +141,18 @@ struct Row {
 }
 
 impl Row {
+    const ZERO: Row = Row {
+        lin: Vec3::ZERO,
+        ang_a: Vec3::ZERO,
+        ang_b: Vec3::ZERO,
+    };
+    /// Adds `lambda` times `row`: impulses along several rows summed into one, applied
+    /// with one product by each inverse inertia instead of one per row.
+    fn add_scaled(&mut self, row: &Row, lambda: Real) {
+        self.lin += row.lin * lambda;
+        self.ang_a += row.ang_a * lambda;
+        self.ang_b += row.ang_b * lambda;
+    }
     fn angular(axis: Vec3) -> Row {
         Row {
             lin: Vec3::ZERO,
@@ -315,10 +327,11 @@ impl JointConstraint {
         blocks: &'b mut B,
     ) -> Option<&'b Block> {
         let slot = blocks.slot(self.block?);
-        if slot.is_none() {
-            *slot = self.hard_rows(fr).map(|hard| Block::new(hard, fr));
+        if !slot.ready {
+            self.hard_rows(fr, &mut slot.hard)?;
+            slot.eliminate(fr);
         }
-        slot.as_ref()
+        Some(slot)
     }
 
     /// Dense indices of the two bodies (`None`: the world).
@@ -380,26 +393,24 @@ impl JointConstraint {
             return;
         }
         let imp = self.impulses;
-        let hard = self.block(fr, blocks).map(|b| &b.hard);
-        let free = self.free_row(fr);
-        let cone = self.cone_row(fr);
+        let mut sum = Row::ZERO;
+        if let Some(h) = self.block(fr, blocks).map(|b| &b.hard) {
+            for (row, lambda) in h.rows[..h.count].iter().zip(imp.hard) {
+                sum.add_scaled(row, lambda);
+            }
+        }
+        if let Some(row) = self.free_line(fr) {
+            sum.add_scaled(&row, free_impulse(&imp));
+        }
+        if let Some((row, _)) = self.cone_row(fr) {
+            sum.add_scaled(&row, imp.cone);
+        }
         let point = self.point_apart().then(|| point_impulse(&imp));
         self.with_states(states, |a, b| {
             if let Some(p) = point {
                 apply_point(p, fr, a, b);
             }
-            for (row, lambda) in hard
-                .iter()
-                .flat_map(|h| h.rows[..h.count].iter().zip(imp.hard))
-            {
-                row.apply(lambda, &fr.sa, &fr.sb, a, b);
-            }
-            if let Some((row, _)) = free {
-                row.apply(free_impulse(&imp), &fr.sa, &fr.sb, a, b);
-            }
-            if let Some((row, _)) = cone {
-                row.apply(imp.cone, &fr.sa, &fr.sb, a, b);
-            }
+            sum.apply(1.0, &fr.sa, &fr.sb, a, b);
         });
     }
 
@@ -424,8 +435,10 @@ impl JointConstraint {
         let mut imp = self.impulses;
         let drive = self.drive;
         let cone = self.cone_row(fr);
+        // Nothing acts on an idle free row: not even its angle is wanted (an atan2).
         let (free, hard) = match self.chain {
             Some(_) => (None, None),
+            None if drive.is_idle() => (None, self.block(fr, blocks)),
             None => (self.free_row(fr), self.block(fr, blocks)),
         };
         let point_mass = self.point_apart().then(|| {
@@ -488,7 +501,7 @@ impl JointConstraint {
             return;
         }
         let hard = self.block(fr, blocks).map(|b| &b.hard);
-        let free = self.free_row(fr).map(|(row, _)| (row, free_impulse(&imp)));
+        let free = self.free_line(fr).map(|row| (row, free_impulse(&imp)));
         let cone = self.cone_row(fr).map(|(row, _)| (row, imp.cone));
         let rows = hard
             .iter()

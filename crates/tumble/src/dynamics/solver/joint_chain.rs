@@ -218,6 +218,19 @@ fn light_chains(joints: &mut [JointConstraint], sims: &[BodySim]) -> Vec<Chain> 
         }
     }
     let link = |k: Option<usize>| k.is_some_and(|k| candidate(k) && reference[k] > 0.0);
+    // No light link, no chain: skip the joint lists (every step of a cart-pole).
+    if !(0..n).any(|k| link(Some(k))) {
+        return Vec::new();
+    }
+    chains_through(joints, n, link)
+}
+
+/// The chains of `joints` joined through the bodies `link` says are links (of `n`).
+fn chains_through(
+    joints: &mut [JointConstraint],
+    n: usize,
+    link: impl Fn(Option<usize>) -> bool,
+) -> Vec<Chain> {
     // Joints joined through links, in list order: each chain is a path of them.
     let mut parent: Vec<usize> = (0..joints.len()).collect();
     let mut by_link: Vec<Option<usize>> = vec![None; n];
@@ -326,7 +339,7 @@ impl Chain {
         &self,
         joints: &[JointConstraint],
         frames: &[Frame],
-        blocks: &mut [Option<super::Block>],
+        blocks: &mut [super::Block],
     ) -> ChainBlock {
         let mut rows = Vec::new();
         let mut reach = Vec::new();
@@ -396,7 +409,7 @@ impl Chain {
         (joints, frames): (&mut [JointConstraint], &[Frame]),
         states: &mut [BodyState],
         pass: impl Fn(&JointConstraint) -> &'p JointPass,
-        (blocks, cache): (&mut [Option<super::Block>], &mut Option<ChainBlock>),
+        (blocks, cache): (&mut [super::Block], &mut Option<ChainBlock>),
     ) {
         if !joints[i].acts_on_free_row() {
             return;
@@ -469,7 +482,7 @@ impl Chain {
         (joints, frames): (&[JointConstraint], &[Frame]),
         states: &mut [BodyState],
         pass: &impl Fn(&JointConstraint) -> &'p JointPass,
-        blocks: &mut [Option<super::Block>],
+        blocks: &mut [super::Block],
     ) -> [f64; CHAIN_ROWS] {
         let mut rhs = [0.0; CHAIN_ROWS];
         for (r, &(m, row)) in chain.rows.iter().enumerate() {
@@ -518,7 +531,7 @@ impl Chain {
         (joints, frames): (&mut [JointConstraint], &[Frame]),
         states: &mut [BodyState],
         pass: impl Fn(&JointConstraint) -> &'p JointPass,
-        (blocks, cache): (&mut [Option<super::Block>], &mut Option<ChainBlock>),
+        (blocks, cache): (&mut [super::Block], &mut Option<ChainBlock>),
     ) {
         let chain = cache.get_or_insert_with(|| self.block(joints, frames, blocks));
         let rhs = self.rhs(chain, (joints, frames), states, &pass, blocks);

@@ -19,13 +19,13 @@ use crate::dynamics::joint::{AngularLock, FreeAxis, LinearLock};
 use crate::math::{orthonormal_basis, Real, Vec3};
 
 impl JointConstraint {
-    /// The joint's equality rows (see the module's table); `None` when there are none to
-    /// solve as a block.
-    pub(super) fn hard_rows(&self, fr: &Frame) -> Option<HardRows> {
+    /// Writes the joint's equality rows (see the module's table) into `hard`; `None` when
+    /// there are none to solve as a block.
+    pub(super) fn hard_rows(&self, fr: &Frame, hard: &mut HardRows) -> Option<()> {
         if !self.has_block() {
             return None;
         }
-        let mut hard = HardRows::default();
+        hard.count = 0;
         match self.spec.linear {
             LinearLock::Point => {
                 for e in [Vec3::X, Vec3::Y, Vec3::Z] {
@@ -60,12 +60,21 @@ impl JointConstraint {
             }
             AngularLock::Free => {}
         }
-        Some(hard)
+        Some(())
     }
 
     /// The joint's axis in the world, carried by body a (hinge, slider).
     fn axis(&self, fr: &Frame) -> Vec3 {
         fr.sa.q * self.axis_a
+    }
+
+    /// The free coordinate's row alone, for the warm start and the totals: the same row
+    /// as [`JointConstraint::free_row`]'s without measuring the angle (an `atan2`).
+    pub(super) fn free_line(&self, fr: &Frame) -> Option<Row> {
+        match self.spec.free? {
+            FreeAxis::Rotation => Some(Row::angular(self.axis(fr)).negated()),
+            _ => self.free_row(fr).map(|(row, _)| row),
+        }
     }
 
     /// The row of the joint's free coordinate and the coordinate's value: the hinge

@@ -109,8 +109,7 @@ fn hubs(sims: &[BodySim], joined: &[Joined]) -> Option<(Vec<bool>, Real)> {
         lin.max(ang)
     };
     let largest = load.iter().map(hub_load).fold(0.0, Real::max);
-    let hub: Vec<bool> = load.iter().map(|l| hub_load(l) > 0.0).collect();
-    (largest > 0.0).then_some((hub, largest))
+    (largest > 0.0).then(|| (load.iter().map(|l| hub_load(l) > 0.0).collect(), largest))
 }
 
 /// Which islands are heavy and how they are solved.

@@ -76,16 +76,16 @@ fn bounce_cluster(
     moves: &[bool],
     threshold: Real,
 ) -> Vec<usize> {
+    let mut bouncing = constraints.iter().filter(|c| c.bounces(points, threshold));
+    let Some(first) = bouncing.next() else {
+        // Nothing bounces (the common step): no per-body scratch.
+        return Vec::new();
+    };
     let mut reached = vec![false; moves.len()];
-    let mut seeded = false;
-    for c in constraints.iter().filter(|c| c.bounces(points, threshold)) {
+    for c in std::iter::once(first).chain(bouncing) {
         let (a, b) = c.bodies();
         reached[a] |= moves[a];
         reached[b] |= moves[b];
-        seeded = true;
-    }
-    if !seeded {
-        return Vec::new();
     }
     // Spread through touched constraints until nothing changes; a pass per link of the
     // longest chain, each linear in the number of constraints.
