@@ -35,12 +35,15 @@ impl SolverBodies {
             self.states.clear();
             return;
         };
-        // Sized without a write to what is already there: every slot is set below.
-        let (sim, state) = BodySim::new(first, solved[0]);
-        self.sims.truncate(n);
-        self.sims.resize(n, sim);
-        self.states.truncate(n);
-        self.states.resize(n, state);
+        // Sized without a write to what is already there: every slot is set below (and
+        // the filler made only when the lists grow).
+        if self.sims.len() != n || self.states.len() != n {
+            let (sim, state) = BodySim::new(first, solved[0]);
+            self.sims.truncate(n);
+            self.sims.resize(n, sim);
+            self.states.truncate(n);
+            self.states.resize(n, state);
+        }
         let size = n.div_ceil(par.pieces(n, BODIES_A_PIECE));
         let pair = (&mut self.sims[..], &mut self.states[..]);
         crate::team::chunks2(par.threads, pair, size, &|start, sims, states| {

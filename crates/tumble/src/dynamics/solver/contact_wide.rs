@@ -118,8 +118,11 @@ impl ContactLanes {
         self.saved = false;
         self.runs.clear();
         self.planned.clear();
-        self.stamp.fill(0);
-        self.tag = 0;
+        if self.tag != 0 {
+            // Only once a run was checked (a zero-length fill still paid for the call).
+            self.stamp.fill(0);
+            self.tag = 0;
+        }
     }
 
     /// Plans the groups of the constraints that `planned` describes (in the solver's

@@ -232,7 +232,9 @@ impl<const N: usize, T: Element> Eliminated<N, T> {
                 continue;
             }
             let pivot_row = k[col];
-            let below = k[col + 1..n].iter_mut().zip(&mut self.factor[col][col + 1..n]);
+            let below = k[col + 1..n]
+                .iter_mut()
+                .zip(&mut self.factor[col][col + 1..n]);
             for (row, factor) in below {
                 let f = row[col] / pivot_row[col];
                 for (kij, pj) in row[col..n].iter_mut().zip(&pivot_row[col..n]) {
