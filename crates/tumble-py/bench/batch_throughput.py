@@ -23,6 +23,12 @@ rollout writes every step's state into its output array, so Tumble is timed both
 `step` (nothing recorded) and `simulate(every=1)` (every step's positions, orientations,
 velocities and angular velocities recorded). The figures are the best of `--repeat`
 runs (default 3), as world-steps per second = W × steps / seconds.
+
+Same dt is not same accuracy, so the script also measures each run's error on a pole let
+go 1 rad from upright (`accuracy`: RMS error over 2 s against MuJoCo's RK4 at 1e-5 s) and
+times MuJoCo where it matches Tumble: its Euler at dt / 4 (as close as Tumble's 1
+substep) and its RK4 at dt (closer than Tumble's 4 substeps), counted per 0.01 s
+simulated.
 """
 
 import argparse
@@ -104,11 +110,16 @@ def tumble_case(scene, copies, steps, threads, repeat, record, kick=0.05):
     return copies * steps / best(setup, repeat)
 
 
-def mujoco_case(copies, steps, threads, repeat):
+def mujoco_case(copies, steps, threads, repeat, integrator="EULER", split=1):
+    """World-steps of 0.01 s per second of MuJoCo's rollout, each 0.01 s taken as `split`
+    steps of 0.01 / split with `integrator` (mjINT_ + its name)."""
     import mujoco
     from mujoco import rollout
 
     model = mujoco.MjModel.from_xml_string(CART_POLE_MJCF)
+    model.opt.timestep = 0.01 / split
+    model.opt.integrator = getattr(mujoco.mjtIntegrator, "mjINT_" + integrator)
+    steps *= split
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     data = mujoco.MjData(model)
     size = mujoco.mj_stateSize(model, spec)
@@ -137,7 +148,56 @@ def mujoco_case(copies, steps, threads, repeat):
                 sensordata=sensordata,
             )
 
-        return copies * steps / best(setup, repeat)
+        return copies * steps / split / best(setup, repeat)
+
+
+def swinging(theta, substeps):
+    """The bench's cart-pole with its pole let go at `theta` (rad) from upright."""
+    scene = json.loads(json.dumps(CART_POLE))
+    scene["substeps"] = substeps
+    pole = scene["bodies"][1]
+    pole["position"] = [0.5 * np.sin(theta), 0.0, 0.5 * np.cos(theta)]
+    pole["orientation"] = [0.0, np.sin(theta / 2), 0.0, np.cos(theta / 2)]
+    return scene
+
+
+def accuracy(theta=1.0, duration=2.0):
+    """RMS error of the pole's angle and the cart's position over `duration`, each engine
+    at dt = 0.01 s against MuJoCo's RK4 at dt = 1e-5 s: whether Tumble at 1 substep is as
+    close to the cart-pole's true motion as MuJoCo's Euler step it is timed against."""
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_string(CART_POLE_MJCF)
+    steps = round(duration / 0.01)
+
+    def mujoco_run(dt, integrator):
+        model.opt.timestep = dt
+        model.opt.integrator = integrator
+        data = mujoco.MjData(model)
+        data.qpos[:] = [0.0, theta]
+        every = round(0.01 / dt)
+        out = []
+        for _ in range(steps):
+            for _ in range(every):
+                mujoco.mj_step(model, data)
+            out.append(data.qpos.copy())
+        return np.array(out)
+
+    truth = mujoco_run(1e-5, mujoco.mjtIntegrator.mjINT_RK4)
+    rows = {"MuJoCo Euler": mujoco_run(0.01, mujoco.mjtIntegrator.mjINT_EULER)}
+    for substeps in (1, 4):
+        world = tumble.World.from_json(json.dumps(swinging(theta, substeps)))
+        out = []
+        for _ in range(steps):
+            world.step(0.01, 1)
+            q = world.orientations[1]
+            out.append([world.positions[0][0], 2.0 * np.arctan2(q[1], q[3])])
+        rows[f"Tumble, {substeps} substep{'s' * (substeps > 1)}"] = np.array(out)
+    print(f"\naccuracy: pole let go {theta} rad from upright, {duration} s at dt = 0.01 s,")
+    print("RMS error against MuJoCo RK4 at dt = 1e-5 s")
+    for name, run in rows.items():
+        err = np.sqrt(np.mean((run - truth) ** 2, axis=0))
+        print(f"  {name:20s} cart {err[0] * 1e3:8.3f} mm   pole {err[1] * 1e3:8.3f} mrad")
 
 
 def main():
@@ -152,13 +212,17 @@ def main():
     rows = []
     for threads in (1, 2):
         w, n = cart
-        step = tumble_case(CART_POLE, w, n, threads, args.repeat, record=False)
-        rec = tumble_case(CART_POLE, w, n, threads, args.repeat, record=True)
+        four = [tumble_case(CART_POLE, w, n, threads, args.repeat, record=r) for r in (0, 1)]
+        one = [tumble_case(CART_POLE_1, w, n, threads, args.repeat, record=r) for r in (0, 1)]
         mj = mujoco_case(w, n, threads, args.repeat)
-        rows.append((f"{w} cart-poles", threads, step, rec, mj))
-        step = tumble_case(CART_POLE_1, w, n, threads, args.repeat, record=False)
-        rec = tumble_case(CART_POLE_1, w, n, threads, args.repeat, record=True)
-        rows.append((f"{w} cart-poles, 1 substep", threads, step, rec, mj))
+        rows.append((f"{w} cart-poles", threads, *four, mj))
+        rows.append((f"{w} cart-poles, 1 substep", threads, *one, mj))
+        # At matched accuracy (see `accuracy`): MuJoCo's Euler needs dt / 4 to come as
+        # close as Tumble's 1 substep; its RK4 at dt beats Tumble's 4 substeps.
+        mj4 = mujoco_case(w, n, threads, args.repeat, split=4)
+        rows.append((f"{w} cart-poles, 1 substep; MuJoCo Euler at dt/4", threads, *one, mj4))
+        rk4 = mujoco_case(w, n, threads, args.repeat, integrator="RK4")
+        rows.append((f"{w} cart-poles; MuJoCo RK4", threads, *four, rk4))
         w, n = ragdoll
         step = tumble_case("ragdoll", w, n, threads, args.repeat, record=False)
         rec = tumble_case("ragdoll", w, n, threads, args.repeat, record=True)
@@ -175,6 +239,7 @@ def main():
     load = os.getloadavg()
     print(f"load average after: {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}")
     print(json.dumps({r[0] + f" x{r[1]}": r[2:] for r in rows}))
+    accuracy()
 
 
 if __name__ == "__main__":

@@ -275,9 +275,8 @@ impl<const N: usize, T: Element> Eliminated<N, T> {
 /// largest diagonal entry is a direction no body can move in (out of a planar body's
 /// plane), and its unknown stays zero, as [`Eliminated`] leaves it. Gaussian elimination
 /// with partial pivoting took some 1,100 instructions on a cart-pole's 5×5 block, made
-/// twice a substep per joint; with the symmetric build and the copies gone, a block costs
-/// 790 instructions where it cost 2,450 (callgrind, cart-pole at 4 substeps: the blocks
-/// went from a third of its step to a sixth).
+/// once a frame per joint; with the symmetric build and the copies gone, a block costs
+/// 1,350 instructions where it cost 2,500 and a kilobyte copied (callgrind, cart-pole).
 #[derive(Clone, Default)]
 struct Factored {
     /// Below the diagonal: L (unit diagonal, not stored); on it: D⁻¹ (0 where skipped).
