@@ -293,45 +293,78 @@ enum Stop {
 /// How often a running loop looks for Ctrl-C (see `steps.rs`).
 const SIGNAL_INTERVAL: Duration = Duration::from_millis(5);
 
+/// Worlds a thread is handed per block (see `run`).
+const WORLDS_PER_THREAD: usize = 8;
+
 /// Steps the batch through steps 1..=`steps` of `plan` with the interpreter released,
-/// calling `after(k, batch)` at every k that is a multiple of `every` and at the last.
-/// Steps go to the engine in chunks (one parallel region each) that grow while a chunk
-/// takes well under the signal interval, so a check for Ctrl-C comes every few ms.
+/// recording into `frames` (when given) step 0's state, every `every`-th step's and the
+/// last's.
+///
+/// Each world takes its steps of a chunk in a row, a block of worlds at a time (a few per
+/// thread), so that a tiny world's data stays in the cache: stepping all 1,024 cart-poles
+/// once before stepping any again ran them at half the speed of one alone. The chunk of
+/// steps doubles while a block takes well under the signal interval, so that Ctrl-C is
+/// looked for every few ms; at the end of a chunk every world (but a failed one) stands
+/// at the same step, and a failure stops the run there, keeping the frames before that
+/// chunk.
 fn run(
     py: Python<'_>,
     batch: &mut Batch,
     plan: &RunPlan,
-    every: u64,
-    mut after: impl FnMut(u64, &Batch) + Send,
+    mut frames: Option<&mut Frames>,
 ) -> Result<(), Stop> {
     py.detach(|| {
+        let w = batch.len();
+        let block = w.min(WORLDS_PER_THREAD * batch.threads());
+        let mut rows: Vec<Rows> = (0..block).map(|_| Rows::default()).collect();
         let (mut k, mut chunk) = (0u64, 1u64);
         let mut last_check = Instant::now();
-        while k < plan.steps {
-            let next_frame = (k / every + 1) * every;
-            let n = chunk.min(plan.steps - k).min(next_frame - k);
-            let began = Instant::now();
-            // All steps but the last are `dt` long; the last may be shorter.
-            let regular = if k + n == plan.steps { n - 1 } else { n };
-            if regular > 0 {
-                batch.step(plan.dt, regular).map_err(Stop::Failed)?;
+        let dt = |j: u64| {
+            if j == plan.steps {
+                plan.last_dt
+            } else {
+                plan.dt
             }
-            if regular < n {
-                batch.step(plan.last_dt, 1).map_err(Stop::Failed)?;
+        };
+        while k < plan.steps {
+            let n = chunk.min(plan.steps - k);
+            let (mut slowest, mut failed) = (Duration::ZERO, None);
+            for first in (0..w).step_by(block) {
+                let each = &mut rows[..block.min(w - first)];
+                let began = Instant::now();
+                let outcome = match frames.as_deref() {
+                    Some(f) => {
+                        batch.step_worlds(first, each, k + 1..k + n + 1, dt, |r, j, world| {
+                            if let Some(t) = f.frame_of(j) {
+                                r.record(t, world);
+                            }
+                        })
+                    }
+                    None => batch.step_worlds(first, each, k + 1..k + n + 1, dt, |_, _, _| ()),
+                };
+                slowest = slowest.max(began.elapsed());
+                if let Some(f) = frames.as_deref_mut() {
+                    f.take(first, each);
+                }
+                if let Err(e) = outcome {
+                    failed.get_or_insert(e);
+                }
+                if last_check.elapsed() >= SIGNAL_INTERVAL {
+                    last_check = Instant::now();
+                    Python::attach(|py| py.check_signals()).map_err(Stop::Python)?;
+                }
+            }
+            if let Some(e) = failed {
+                if let Some(f) = frames.as_deref_mut() {
+                    f.truncate(k);
+                }
+                return Err(Stop::Failed(e));
             }
             k += n;
-            if k % every == 0 || k == plan.steps {
-                after(k, batch);
-            }
-            let took = began.elapsed();
-            if took < SIGNAL_INTERVAL / 4 && chunk < 1 << 20 {
+            if slowest < SIGNAL_INTERVAL / 4 && chunk < 1 << 20 {
                 chunk *= 2;
-            } else if took > SIGNAL_INTERVAL * 2 {
+            } else if slowest > SIGNAL_INTERVAL * 2 {
                 chunk = (chunk / 2).max(1);
-            }
-            if last_check.elapsed() >= SIGNAL_INTERVAL {
-                last_check = Instant::now();
-                Python::attach(|py| py.check_signals()).map_err(Stop::Python)?;
             }
         }
         Ok(())
@@ -527,10 +560,11 @@ impl PyBatch {
     }
 
     /// Steps every world `steps` times by `dt` (default: the scene's, else 0.01), with
-    /// the interpreter's lock released; Ctrl-C stops it between two chunks of steps. A
-    /// world whose step fails (not finite, too fast) stays at its last good step while
-    /// the others finish; SimulationError then names it (`worlds[3]: step 41 ...`, and
-    /// the attribute `world`).
+    /// the interpreter's lock released; Ctrl-C stops it within a few ms (the worlds may
+    /// then stand at different steps: `step_counts`). A world whose step fails (not
+    /// finite, too fast) stays at its last good step while the others finish the chunk
+    /// of steps under way and stop together; SimulationError then names it (`worlds[3]:
+    /// step 41 ...`, and the attribute `world`).
     #[pyo3(signature = (dt = None, steps = None))]
     fn step(
         &self,
@@ -543,7 +577,7 @@ impl PyBatch {
         let mut g = self.lock()?;
         let dt = dt.map_or(g.dt, real);
         let plan = RunPlan::from_steps(steps, dt).map_err(scene)?;
-        match run(py, &mut g.batch, &plan, u64::MAX, |_, _| ()) {
+        match run(py, &mut g.batch, &plan, None) {
             Ok(()) => Ok(()),
             Err(Stop::Failed(f)) => Err(failure(py, &f, None)),
             Err(Stop::Python(e)) => Err(e),
@@ -800,6 +834,11 @@ impl PyBatch {
 /// A batch's recording: flat buffers of (T, W, N, ·).
 #[derive(Default)]
 struct Frames {
+    /// Every `every`-th step is recorded, and the last (`steps`).
+    every: u64,
+    steps: u64,
+    worlds: usize,
+    bodies: usize,
     time: Vec<f64>,
     position: Vec<f64>,
     orientation: Vec<f64>,
@@ -808,16 +847,102 @@ struct Frames {
 }
 
 impl Frames {
-    fn frame(&mut self, batch: &Batch, time: f64) {
-        self.time.push(time);
-        for world in batch.worlds() {
-            for (_, b) in world.bodies() {
-                push3(&mut self.position, b.position());
-                push4(&mut self.orientation, b.orientation());
-                push3(&mut self.velocity, b.linear_velocity());
-                push3(&mut self.angular_velocity, b.angular_velocity());
-            }
+    /// Room for every frame of a run of `plan`, step 0's filled in from `batch`.
+    fn new(batch: &Batch, plan: &RunPlan, every: u64) -> Frames {
+        let count = crate::sim::frame_count(plan.steps, every) as usize;
+        let (worlds, bodies) = (batch.len(), batch.body_ids().len());
+        let zeros = |width: usize| vec![0.0; count * worlds * bodies * width];
+        let mut f = Frames {
+            every,
+            steps: plan.steps,
+            worlds,
+            bodies,
+            time: (0..count as u64)
+                .map(|t| wide(plan.time_after((t * every).min(plan.steps))))
+                .collect(),
+            position: zeros(3),
+            orientation: zeros(4),
+            velocity: zeros(3),
+            angular_velocity: zeros(3),
+        };
+        let mut r = Rows::default();
+        for (i, world) in batch.worlds().iter().enumerate() {
+            r.record(0, world);
+            f.take(i, std::slice::from_mut(&mut r));
         }
+        f
+    }
+
+    /// The frame step `k` is recorded in, if it is.
+    fn frame_of(&self, k: u64) -> Option<usize> {
+        if k % self.every == 0 {
+            Some((k / self.every) as usize)
+        } else if k == self.steps {
+            Some((k / self.every + 1) as usize)
+        } else {
+            None
+        }
+    }
+
+    /// Moves the rows recorded by worlds `first..` (one `Rows` each) to their frames.
+    fn take(&mut self, first: usize, each: &mut [Rows]) {
+        let (w, n) = (self.worlds, self.bodies);
+        for (i, r) in each.iter_mut().enumerate() {
+            for (j, &t) in r.frames.iter().enumerate() {
+                let at = t * w + first + i;
+                let copy = |to: &mut Vec<f64>, from: &[f64], width: usize| {
+                    let len = n * width;
+                    to[at * len..(at + 1) * len].copy_from_slice(&from[j * len..(j + 1) * len]);
+                };
+                copy(&mut self.position, &r.position, 3);
+                copy(&mut self.orientation, &r.orientation, 4);
+                copy(&mut self.velocity, &r.velocity, 3);
+                copy(&mut self.angular_velocity, &r.angular_velocity, 3);
+            }
+            r.clear();
+        }
+    }
+
+    /// Keeps the frames of steps 0..=`k` only.
+    fn truncate(&mut self, k: u64) {
+        let count = (k / self.every + 1) as usize;
+        let per = self.worlds * self.bodies;
+        self.time.truncate(count);
+        self.position.truncate(count * per * 3);
+        self.orientation.truncate(count * per * 4);
+        self.velocity.truncate(count * per * 3);
+        self.angular_velocity.truncate(count * per * 3);
+    }
+}
+
+/// One world's bodies at the frames it reached in a chunk of steps.
+#[derive(Default)]
+struct Rows {
+    frames: Vec<usize>,
+    position: Vec<f64>,
+    orientation: Vec<f64>,
+    velocity: Vec<f64>,
+    angular_velocity: Vec<f64>,
+}
+
+impl Rows {
+    fn record(&mut self, frame: usize, world: &World) {
+        self.frames.push(frame);
+        for (_, b) in world.bodies() {
+            push3(&mut self.position, b.position());
+            push4(&mut self.orientation, b.orientation());
+            push3(&mut self.velocity, b.linear_velocity());
+            push3(&mut self.angular_velocity, b.angular_velocity());
+        }
+    }
+
+    /// Empties the rows, keeping their room.
+    fn clear(&mut self) {
+        self.frames.clear();
+        self.position.clear();
+        self.orientation.clear();
+        self.velocity.clear();
+        self.angular_velocity.clear();
     }
 }
 
@@ -863,11 +988,8 @@ impl PyBatch {
         let (w, n) = (g.batch.len(), g.batch.body_ids().len());
         let frames = crate::sim::frame_count(plan.steps, every);
         crate::sim::check_fits(py, field, frames, w.saturating_mul(n), false)?;
-        let mut rec = Frames::default();
-        rec.frame(&g.batch, 0.0);
-        let outcome = run(py, &mut g.batch, &plan, every, |k, b| {
-            rec.frame(b, wide(plan.time_after(k)))
-        });
+        let mut rec = Frames::new(&g.batch, &plan, every);
+        let outcome = run(py, &mut g.batch, &plan, Some(&mut rec));
         let t = rec.time.len();
         let traj = crate::sim::Trajectory::of_frames(
             py,

@@ -148,6 +148,31 @@ def test_simulate_records_what_a_world_records():
         assert np.array_equal(a.angular_velocity[:, i], b.angular_velocity)
 
 
+@pytest.mark.parametrize("threads", [1, 2])
+def test_many_worlds_recorded_in_blocks_equal_worlds_recorded_alone(threads):
+    # More worlds than one block (8 a thread) and a run long enough for the loop's chunk
+    # of steps to grow: each world takes a chunk's steps in a row, and its frames must
+    # land in the right (frame, world) rows, the cut last step included.
+    w, every, duration = 37, 7, 2.005
+    batch = tumble.Batch(CART_POLE, copies=w, threads=threads)
+    v = batch.velocities
+    v[:, :, 0] += np.linspace(-0.5, 0.5, w)[:, None]
+    batch.velocities = v
+    traj = batch.simulate(duration=duration, dt=0.01, every=every)
+    assert traj.position.shape == (201 // every + 2, w, 2, 3)
+    for i in [0, 1, 15, 16, 17, 31, 32, 36]:
+        world = world_of(CART_POLE)
+        world.velocities = v[i]
+        alone = world.simulate(duration=duration, dt=0.01, every=every)
+        np.testing.assert_array_equal(traj.time, alone.time)
+        assert np.array_equal(traj.position[:, i], alone.position), i
+        assert np.array_equal(traj.orientation[:, i], alone.orientation), i
+        assert np.array_equal(traj.velocity[:, i], alone.velocity), i
+        assert np.array_equal(traj.angular_velocity[:, i], alone.angular_velocity), i
+        assert np.array_equal(batch.positions[i], world.positions), i
+    assert batch.step_counts == [201] * w
+
+
 @pytest.mark.parametrize("mass,dt,steps", [(2.0, 0.01, 50), (0.3, 1 / 240, 120)])
 def test_a_force_on_world_two_moves_world_two_only(mass, dt, steps):
     # Constant F on a free body, no gravity: Δv = F t / m exactly up to one rounding per
@@ -327,7 +352,14 @@ def test_a_world_with_a_callback_is_refused_and_a_failed_world_is_named():
         batch.simulate(steps=20, dt=0.01, every=1)
     assert str(e.value).startswith("worlds[1]: step ")
     assert e.value.world == 1 and e.value.quantity == "velocity"
-    assert e.value.trajectory.position.shape[1:] == (3, 1, 3)
+    traj = e.value.trajectory
+    assert traj.position.shape[1:] == (3, 1, 3)
+    # The frames kept are whole: every world's row written (no zero quaternion), up to
+    # a step every world reached.
+    frames = len(traj.time)
+    assert traj.orientation.shape[0] == frames >= 1
+    assert np.all(np.abs(np.linalg.norm(traj.orientation, axis=-1) - 1) < 1e-12)
+    assert np.all(traj.position[:, 1, 0, 0] >= 0)
     counts = batch.step_counts
     assert counts[0] == counts[2] and counts[1] < counts[0]
 

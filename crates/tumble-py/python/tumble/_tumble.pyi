@@ -903,8 +903,10 @@ class Batch:
     """(W, N, 3) angular velocities (rad/s, world frame); assignable."""
     def step(self, dt: Optional[float] = None, steps: int = 1) -> None:
         """Steps every world ``steps`` times by dt (default the scene's), the interpreter's
-        lock released. A world whose step fails stays at its last good step while the
-        others finish; SimulationError names it (``worlds[3]: step 41 ...``, ``.world``)."""
+        lock released; Ctrl-C stops it within a few ms (worlds may then stand at different
+        steps: ``step_counts``). A world whose step fails stays at its last good step while
+        the others finish the chunk of steps under way and stop together; SimulationError
+        names it (``worlds[3]: step 41 ...``, ``.world``)."""
     def apply_forces(self, forces: npt.ArrayLike, torques: Optional[npt.ArrayLike] = None) -> None:
         """Constant forces (N, at each centre of mass) and torques (N·m), (W, N, 3), acting
         from now on at every step until the next apply_forces or clear_forces (they persist,

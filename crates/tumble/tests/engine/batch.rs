@@ -415,3 +415,38 @@ fn a_failing_world_is_named_and_the_others_finish() {
         }
     }
 }
+
+#[test]
+fn step_worlds_steps_a_range_of_worlds_each_through_its_numbered_steps() {
+    // Worlds 1 and 2 of four take steps 5..9 (step 8 half as long); `after` sees each
+    // world after each of its steps, in order, and the world equals one stepped alone.
+    for threads in [1, 2] {
+        let mut batch = Batch::new(&jointed_scene(), 4, Some(threads)).unwrap();
+        let mut seen: Vec<Vec<(u64, u64)>> = vec![Vec::new(); 2];
+        let dt = |k: u64| if k == 8 { 0.005 } else { 0.01 };
+        batch
+            .step_worlds(1, &mut seen, 5..9, dt, |s, k, w| {
+                s.push((k, w.step_count()))
+            })
+            .unwrap();
+        for s in &seen {
+            assert_eq!(s, &[(5, 1), (6, 2), (7, 3), (8, 4)], "{threads} threads");
+        }
+        let counts: Vec<u64> = batch.worlds().iter().map(World::step_count).collect();
+        assert_eq!(counts, [0, 4, 4, 0]);
+        let mut alone = jointed_scene();
+        for k in 5..9 {
+            alone.step(dt(k)).unwrap();
+        }
+        assert_eq!(state(batch.world(2).unwrap()), state(&alone));
+        // Past the last world: refused before anything steps.
+        let e = batch
+            .step_worlds(3, &mut [(), ()], 0..1, dt, |_, _, _| ())
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "worlds[3]: world: index 4 out of range for a batch of 4 worlds"
+        );
+        assert_eq!(batch.world(3).unwrap().step_count(), 0);
+    }
+}
