@@ -49,7 +49,7 @@ use crate::math::{Mat3, Quat, Real, Vec3};
 use crate::team::Parts;
 pub(crate) use block::Block;
 use block::{apply_point, point_impulse, point_inverse_mass, solve_hard, solve_point};
-pub(crate) use chain::{find_chains, Chain, ChainBlock};
+pub(crate) use chain::{find_chains, Chain, ChainBlock, ChainLists};
 use one_d::{free_impulse, solve_free, solve_limit, FreeDrive, Line};
 
 /// The solver's hard blocks of the joints, by `JointConstraint::block`: a slice when one

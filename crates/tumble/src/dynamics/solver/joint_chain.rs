@@ -156,8 +156,12 @@ impl ChainBlock {
 
 /// Finds the chains among `joints` (the solver's list, their `chain` unset), marks their
 /// members, and returns them.
-pub(crate) fn find_chains(joints: &mut [JointConstraint], sims: &[BodySim]) -> Vec<Chain> {
-    let mut chains = light_chains(joints, sims);
+pub(crate) fn find_chains(
+    joints: &mut [JointConstraint],
+    sims: &[BodySim],
+    lists: &mut ChainLists,
+) -> Vec<Chain> {
+    let mut chains = light_chains(joints, sims, lists);
     // A joint with an armature needs its free row's mass with its hard rows holding (see
     // `joint_armature.rs`): out of a chain, it is a chain of its own.
     for (i, j) in joints.iter_mut().enumerate() {
@@ -169,17 +173,44 @@ pub(crate) fn find_chains(joints: &mut [JointConstraint], sims: &[BodySim]) -> V
     chains
 }
 
+/// The chain search's per-body lists, kept by the solver from step to step.
+#[derive(Default)]
+pub(crate) struct ChainLists {
+    /// Per body, its joints, and those of them with a hard block.
+    count: Vec<u32>,
+    blocked: Vec<u32>,
+    /// A candidate's two partners (`None`: the world), the only ones the search needs.
+    partners: Vec<[Option<usize>; 2]>,
+    /// Each link's reference: the heavy mass it is light against.
+    reference: Vec<Real>,
+}
+
+/// Empties `list` and fills it with `n` times `value`, keeping its room.
+fn refill<T: Clone>(list: &mut Vec<T>, n: usize, value: T) {
+    list.clear();
+    list.resize(n, value);
+}
+
 /// The chains of joints through light bodies (see the module's header).
-fn light_chains(joints: &mut [JointConstraint], sims: &[BodySim]) -> Vec<Chain> {
+fn light_chains(
+    joints: &mut [JointConstraint],
+    sims: &[BodySim],
+    lists: &mut ChainLists,
+) -> Vec<Chain> {
     // A chain has two joints at least; without, skip the per-body lists (every step).
     if joints.len() < 2 {
         return Vec::new();
     }
     let n = sims.len();
-    let mut count = vec![0u32; n];
-    let mut blocked = vec![0u32; n];
-    // A candidate's two partners (`None`: the world), the only ones the search needs.
-    let mut partners: Vec<[Option<usize>; 2]> = vec![[None; 2]; n];
+    let ChainLists {
+        count,
+        blocked,
+        partners,
+        reference,
+    } = lists;
+    refill(count, n, 0);
+    refill(blocked, n, 0);
+    refill(partners, n, [None; 2]);
     for j in joints.iter() {
         let [a, b] = j.bodies();
         for (k, other) in [(a, b), (b, a)] {
@@ -200,7 +231,7 @@ fn light_chains(joints: &mut [JointConstraint], sims: &[BodySim]) -> Vec<Chain> 
         _ => 0.0,
     };
     // Each link's reference: the heavy mass it is light against, spread along the chain.
-    let mut reference: Vec<Real> = vec![0.0; n];
+    refill(reference, n, 0.0);
     loop {
         let mut changed = false;
         for k in (0..n).filter(|&k| candidate(k)) {

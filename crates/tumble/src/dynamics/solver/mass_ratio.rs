@@ -81,14 +81,21 @@ fn mean_moment(s: &BodySim) -> Real {
 /// partners, shared among several (at most half of it from one: a light body under one
 /// heavy partner is a pair's ratio, cured as such), and the largest such load; `None`
 /// when no body does, found in one scan of the joints.
-fn hubs(sims: &[BodySim], joined: &[Joined]) -> Option<(Vec<bool>, Real)> {
+fn hubs(
+    sims: &[BodySim],
+    joined: &[Joined],
+    load: &mut Vec<[Real; 4]>,
+) -> Option<(Vec<bool>, Real)> {
     // Without joints there is no hub, and no per-body scratch to fill (the rain's 2,000).
     if joined.is_empty() {
         return None;
     }
     let moving = |k: usize| sims[k].moves;
     // Per body: [sum, largest] of the partners' mass ratios, then of their moment ratios.
-    let mut load = vec![[0.0 as Real; 4]; sims.len()];
+    // The list is the caller's, kept from step to step (a tiny world's step allocates
+    // nothing).
+    load.clear();
+    load.resize(sims.len(), [0.0; 4]);
     let mut add = |k: usize, at: usize, r: Real| {
         load[k][at] += r;
         load[k][at + 1] = load[k][at + 1].max(r);
@@ -134,6 +141,7 @@ pub(crate) fn heavy_islands(
     sims: &[BodySim],
     links: impl Iterator<Item = (usize, usize)> + Clone,
     joined: &[Joined],
+    load: &mut Vec<[Real; 4]>,
 ) -> Option<Heavy> {
     let moving = |k: usize| sims[k].moves;
     let ratio = |(a, b): (usize, usize)| {
@@ -146,7 +154,7 @@ pub(crate) fn heavy_islands(
     };
     let heavy_pair = |l: (usize, usize)| ratio(l) >= HEAVY_RATIO;
     let largest = links.clone().map(ratio).fold(1.0, Real::max);
-    let (hub, hub_load) = hubs(sims, joined).unzip();
+    let (hub, hub_load) = hubs(sims, joined, load).unzip();
     if largest < HEAVY_RATIO && hub.is_none() {
         return None;
     }
