@@ -41,6 +41,13 @@ pub const MAX_HERTZ: Real = 1e6;
 pub const MAX_DAMPING_RATIO: Real = 1e6;
 /// Largest accepted |gravity_scale| of a body: a million times the world's gravity.
 pub const MAX_GRAVITY_SCALE: Real = 1e6;
+/// Most solver substeps a step may take, and most passes a substep may make: far beyond
+/// any scene's needs (the defaults are 4 and 1), and small enough that a tall stack's
+/// finer substeps (up to 8 times as many) stay countable in `u32` and that a step with
+/// both at their limit still ends in minutes rather than never.
+pub const MAX_SUBSTEPS: u32 = 10_000;
+/// See [`MAX_SUBSTEPS`].
+pub const MAX_ITERATIONS: u32 = 10_000;
 /// Largest accepted magnitude of any other coefficient: stiffness (N/m), damping (N·s/m),
 /// forces (N), impulses (N·s), torques, drag and motor limits.
 pub const MAX_MAGNITUDE: Real = 1e15;

@@ -456,28 +456,7 @@ impl World {
 
     /// Changes the solver settings from the next step on.
     pub fn set_solver_settings(&mut self, settings: SolverSettings) -> Result<()> {
-        if settings.substeps == 0 {
-            return Err(Error::invalid("substeps", "must be >= 1"));
-        }
-        if settings.iterations == 0 {
-            return Err(Error::invalid("iterations", "must be >= 1"));
-        }
-        use crate::limits::{MAX_DAMPING_RATIO, MAX_HERTZ};
-        for (field, hz) in [
-            ("contact_hertz", settings.contact_hertz),
-            ("joint_hertz", settings.joint_hertz),
-        ] {
-            check::positive(field, hz)?;
-            check::at_most(field, hz, MAX_HERTZ, "Hz")?;
-        }
-        for (field, ratio) in [
-            ("contact_damping_ratio", settings.contact_damping_ratio),
-            ("joint_damping_ratio", settings.joint_damping_ratio),
-        ] {
-            check::non_negative(field, ratio)?;
-            check::at_most(field, ratio, MAX_DAMPING_RATIO, "")?;
-        }
-        check::non_negative("baumgarte", settings.baumgarte)?;
+        check_solver_settings(&settings)?;
         self.settings.solver = settings;
         Ok(())
     }
@@ -560,6 +539,37 @@ impl World {
     pub fn state_hash(&self) -> u64 {
         diagnostics::state_hash(&self.bodies.list)
     }
+}
+
+/// The rules for solver settings, in `World::set_solver_settings` and for a snapshot's.
+pub(crate) fn check_solver_settings(settings: &SolverSettings) -> Result<()> {
+    use crate::limits::{MAX_DAMPING_RATIO, MAX_HERTZ, MAX_ITERATIONS, MAX_SUBSTEPS};
+    for (field, n, most) in [
+        ("substeps", settings.substeps, MAX_SUBSTEPS),
+        ("iterations", settings.iterations, MAX_ITERATIONS),
+    ] {
+        if n == 0 {
+            return Err(Error::invalid(field, "must be >= 1"));
+        }
+        if n > most {
+            return Err(Error::invalid(field, format!("must be <= {most}")));
+        }
+    }
+    for (field, hz) in [
+        ("contact_hertz", settings.contact_hertz),
+        ("joint_hertz", settings.joint_hertz),
+    ] {
+        check::positive(field, hz)?;
+        check::at_most(field, hz, MAX_HERTZ, "Hz")?;
+    }
+    for (field, ratio) in [
+        ("contact_damping_ratio", settings.contact_damping_ratio),
+        ("joint_damping_ratio", settings.joint_damping_ratio),
+    ] {
+        check::non_negative(field, ratio)?;
+        check::at_most(field, ratio, MAX_DAMPING_RATIO, "")?;
+    }
+    check::non_negative("baumgarte", settings.baumgarte)
 }
 
 crate::codec::codec_struct!(Tolerances {
