@@ -58,8 +58,13 @@ pub(crate) const HUB_PASSES: u32 = 16;
 /// as did six of a hundred times; sixteen of ten times (160) rang at 12 and held at 14.
 /// Twenty-four of a hundred times (800) rang even at 16: more passes are not a cure
 /// without end, and such a hub needs the joints solved together (not built).
+/// Saturating: a load past 2^64 (a 1e15 kg body on a 1e-12 kg one, or an infinite mass
+/// ratio) overflowed the `+ 1` in a debug build and wrapped to the fewest passes in a
+/// release build.
 fn hub_passes(load: Real) -> u32 {
-    ((load.sqrt().ceil() as u32) + 1).clamp(4, HUB_PASSES)
+    (load.sqrt().ceil() as u32)
+        .saturating_add(1)
+        .clamp(4, HUB_PASSES)
 }
 
 /// A joint between two bodies of the step, as the hub search sees it.
