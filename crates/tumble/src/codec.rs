@@ -99,6 +99,40 @@ impl<'a> Reader<'a> {
     }
 }
 
+/// Refuses a decoded snapshot unless `index < len`: an index the bytes hold is checked
+/// against what it indexes before anything is trusted with it. The message names the
+/// field (built only on failure) and both numbers: `contacts[3].index_b: body 17 of 5`.
+#[inline]
+pub(crate) fn check_index(
+    index: impl Into<u64>,
+    len: usize,
+    (field, noun): (impl FnOnce() -> String, &str),
+) -> Decoded<()> {
+    let index = index.into();
+    if index < len as u64 {
+        Ok(())
+    } else {
+        Err(out_of_range(field(), noun, index, len))
+    }
+}
+
+/// `check_index`'s error, out of line: checks run per node and pair of a large world.
+#[cold]
+#[inline(never)]
+fn out_of_range(field: String, noun: &str, index: u64, len: usize) -> Malformed {
+    Malformed(format!("{field}: {noun} {index} of {len}"))
+}
+
+/// Refuses a decoded snapshot unless `ok`, saying `what` is wrong (built only on failure).
+#[inline]
+pub(crate) fn ensure(ok: bool, what: impl FnOnce() -> String) -> Decoded<()> {
+    if ok {
+        Ok(())
+    } else {
+        Err(Malformed(what()))
+    }
+}
+
 /// A value that can be written to and read from a snapshot.
 pub(crate) trait Code: Sized {
     fn put(&self, w: &mut Writer);

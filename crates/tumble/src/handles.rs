@@ -206,19 +206,23 @@ impl<H: Handle> Handles<H> {
     }
 
     /// Whether every live handle names a slot of its generation that points back at it,
-    /// and every free slot is free: what a snapshot must hold before it is trusted.
+    /// and the free list holds each free slot once: what a snapshot must hold before it is
+    /// trusted (a slot listed twice would be handed out twice, to two live items).
     fn consistent(&self) -> bool {
         let live = self.ids.iter().enumerate().all(|(i, id)| {
             self.slots
                 .get(id.index() as usize)
                 .is_some_and(|s| s.generation == id.generation() && s.dense == Some(i as u32))
         });
+        let mut listed = vec![false; self.slots.len()];
         let free = self.free.iter().all(|&f| {
-            self.slots
+            let free = self
+                .slots
                 .get(f as usize)
-                .is_some_and(|s| s.dense.is_none())
+                .is_some_and(|s| s.dense.is_none());
+            free && !std::mem::replace(&mut listed[f as usize], true)
         });
         let taken = self.slots.iter().filter(|s| s.dense.is_some()).count();
-        live && free && taken == self.ids.len()
+        live && free && taken == self.ids.len() && taken + self.free.len() == self.slots.len()
     }
 }

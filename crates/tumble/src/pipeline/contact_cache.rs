@@ -1087,6 +1087,34 @@ const _: () = assert!(crate::collision::narrow_phase::MAX_MANIFOLD_POINTS < 32);
 /// How close an unnamed point must be to last step's to inherit its impulses (m).
 const MATCH_DISTANCE: Real = 0.01;
 
+impl ContactCache {
+    /// Checks a cache read from a snapshot against the bodies' handles `ids`: each
+    /// contact's dense indices in range, in order (the broad phase pairs them lower first)
+    /// and naming its bodies' handles, and its manifold's point count within the array.
+    /// Everything else the cache holds is rebuilt by the next update before it is read.
+    pub(crate) fn check_saved(&self, ids: &[BodyId]) -> crate::codec::Decoded<()> {
+        use crate::codec::{check_index, ensure};
+        for (k, c) in self.contacts.iter().enumerate() {
+            let field = || format!("contacts[{k}].index_b");
+            check_index(c.index_b, ids.len(), (field, "body"))?;
+            ensure(c.index_a < c.index_b, || {
+                format!("contacts[{k}]: bodies {} and {}", c.index_a, c.index_b)
+            })?;
+            let named = (ids[c.index_a as usize], ids[c.index_b as usize]);
+            ensure(named == (c.body_a, c.body_b), || {
+                format!(
+                    "contacts[{k}]: handles not those of bodies {} and {}",
+                    c.index_a, c.index_b
+                )
+            })?;
+            ensure(c.manifold.count_fits(), || {
+                format!("contacts[{k}].manifold: {} points", c.manifold.len())
+            })?;
+        }
+        Ok(())
+    }
+}
+
 // Between steps a cache is its contacts, touching pairs and events (and the counts the
 // next update reads); `previous` and the `_before` lists are overwritten by the next
 // update before anything reads them, and the rest is scratch.

@@ -401,6 +401,22 @@ fn holds(p: &Body, o: &Body, out: Vec3, at: Vec3, rule: &OneWayRule) -> bool {
     v.dot(n).min(after.dot(n)) <= rule.speed
 }
 
+impl Hooks {
+    /// Checks hooks read from a snapshot against the bodies: the one-way count, which
+    /// each removal subtracts from (it must not underflow). The verdicts hold handles;
+    /// `materials` and `passing` are rebuilt by the next contact update before they are
+    /// read (and `passing` goes stale when a body is removed, so it is not checked).
+    pub(crate) fn check_saved(&self, bodies: &[Body]) -> crate::codec::Decoded<()> {
+        let one_way = bodies.iter().filter(|b| b.one_way.is_some()).count();
+        crate::codec::ensure(self.one_way_bodies == one_way, || {
+            format!(
+                "hooks.one_way_bodies: {} but {one_way} bodies are one-way",
+                self.one_way_bodies
+            )
+        })
+    }
+}
+
 crate::codec::codec_struct!(Verdicts { list, next });
 // The filter and modifier are code: the world restored into keeps its own (see
 // `pipeline/world/snapshot.rs`).

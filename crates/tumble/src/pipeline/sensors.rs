@@ -190,6 +190,21 @@ fn changes(
     }
 }
 
+impl SensorStore {
+    /// Checks sensors read from a snapshot against the bodies: the sensor count, which
+    /// each removal or flag change subtracts from (it must not underflow). The overlaps
+    /// and events hold handles, which nothing indexes by.
+    pub(crate) fn check_saved(&self, bodies: &[Body]) -> crate::codec::Decoded<()> {
+        let sensors = bodies.iter().filter(|b| b.sensor).count();
+        crate::codec::ensure(self.sensor_bodies == sensors, || {
+            format!(
+                "sensors.sensor_bodies: {} but {sensors} bodies are sensors",
+                self.sensor_bodies
+            )
+        })
+    }
+}
+
 crate::codec::codec_struct!(SensorEvent {
     sensor,
     body,

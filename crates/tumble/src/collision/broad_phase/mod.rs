@@ -718,6 +718,149 @@ fn merge(a: &[PairEntry], b: &[PairEntry], out: &mut Vec<PairEntry>) {
     out.extend_from_slice(&b[j..]);
 }
 
+impl BroadPhase {
+    /// Checks a broad phase read from a snapshot against the world's bodies (body `i` is
+    /// static if `is_static(i)`, its proxy is `owned[i]`): each body's proxy live, in the
+    /// tree of its kind, with the body's index as its user, and no other proxy live; the
+    /// trees (`Tree::check_saved`), each leaf the node of the proxy it names; then the
+    /// bookkeeping every call indexes by proxy without checking.
+    pub(crate) fn check_saved(
+        &self,
+        owned: &[ProxyId],
+        is_static: impl Fn(usize) -> bool,
+    ) -> crate::codec::Decoded<()> {
+        use crate::codec::{check_index, ensure};
+        let margin = self.margin;
+        ensure(margin.is_finite() && margin >= 0.0, || {
+            format!("broad_phase.margin: {margin}")
+        })?;
+        let slots = self.proxies.len();
+        for (i, &ProxyId(id)) in owned.iter().enumerate() {
+            let field = || format!("proxies[{i}]");
+            check_index(id, slots, (field, "proxy"))?;
+            let p = &self.proxies[id as usize];
+            let kind = if is_static(i) {
+                ProxyKind::Static
+            } else {
+                ProxyKind::Moving
+            };
+            let fits = p.node != NULL && p.user as usize == i && p.kind == kind;
+            ensure(fits, || {
+                format!("proxies[{i}]: proxy {id} is not body {i}'s")
+            })?;
+        }
+        let live = self.proxies.iter().filter(|p| p.node != NULL).count();
+        ensure(live == owned.len() && self.count == live, || {
+            let bodies = owned.len();
+            format!(
+                "broad_phase: {live} live proxies, a count of {}, {bodies} bodies",
+                self.count
+            )
+        })?;
+        for (t, tree) in self.trees.iter().enumerate() {
+            let mine = |p: &Proxy| p.node != NULL && tree_index(p.kind) == t;
+            let leaves = self.proxies.iter().filter(|p| mine(p)).count();
+            ensure(tree.leaf_count() == leaves, || {
+                format!(
+                    "broad_phase.trees[{t}]: {} leaves for {leaves} proxies",
+                    tree.leaf_count()
+                )
+            })?;
+            // Each leaf the node of the proxy it names: with the counts equal, leaves and
+            // proxies pair off one to one.
+            tree.check_saved(&format!("broad_phase.trees[{t}]"), |node, item| {
+                let p = self.proxies.get(item as usize);
+                p.is_some_and(|p| mine(p) && p.node == node)
+            })?;
+        }
+        self.check_free_proxies()?;
+        self.check_moved()?;
+        self.check_pairs()?;
+        let tight = self.crowd.tight.len();
+        ensure(tight == slots, || {
+            format!("broad_phase.crowd.tight: {tight} boxes for {slots} proxies")
+        })?;
+        // Set only within `pairs()`, which clears them all before it returns.
+        ensure(self.crowd.lost.iter().all(|&w| w == 0), || {
+            "broad_phase.crowd.lost: bits set between updates".to_string()
+        })
+    }
+
+    /// The free list of proxy slots: in range, free, ending, and holding every free slot.
+    fn check_free_proxies(&self) -> crate::codec::Decoded<()> {
+        use crate::codec::{check_index, ensure};
+        let slots = self.proxies.len();
+        let mut listed = vec![false; slots];
+        let mut next = self.free.unwrap_or(NULL);
+        while next != NULL {
+            check_index(next, slots, (|| "broad_phase.free".to_string(), "proxy"))?;
+            let p = &self.proxies[next as usize];
+            let reused = p.node != NULL || listed[next as usize];
+            ensure(!reused, || {
+                format!("broad_phase.free: proxy {next} is in use")
+            })?;
+            listed[next as usize] = true;
+            next = p.next_free;
+        }
+        let free = listed.iter().filter(|&&l| l).count();
+        ensure(free + self.count == slots, || {
+            format!(
+                "broad_phase.free: {free} listed of {} free",
+                slots - self.count
+            )
+        })
+    }
+
+    /// The moved bits (one word per 64 slots) and the move buffer: each buffered proxy in
+    /// range and marked, once, and no other bit set.
+    fn check_moved(&self) -> crate::codec::Decoded<()> {
+        use crate::codec::{check_index, ensure};
+        let slots = self.proxies.len();
+        let words = self.moved.len();
+        ensure(words == slots.div_ceil(64), || {
+            format!("broad_phase.moved: {words} words for {slots} proxies")
+        })?;
+        let mut left = self.moved.clone();
+        for (k, &id) in self.move_buffer.iter().enumerate() {
+            let field = || format!("broad_phase.move_buffer[{k}]");
+            check_index(id, slots, (field, "proxy"))?;
+            ensure(bit(&left, id), || {
+                format!("broad_phase.move_buffer[{k}]: proxy {id} unmarked or twice")
+            })?;
+            set_bit(&mut left, id, false);
+        }
+        ensure(left.iter().all(|&w| w == 0), || {
+            "broad_phase.moved: a proxy marked but not in the move buffer".to_string()
+        })
+    }
+
+    /// The kept pairs: sorted, each of two proxies in range, and, unless one of them moved
+    /// (the next `pairs()` drops those first), of two live proxies under their users now:
+    /// the contact update reads those users as body indices.
+    fn check_pairs(&self) -> crate::codec::Decoded<()> {
+        use crate::codec::{check_index, ensure};
+        let slots = self.proxies.len();
+        for (k, e) in self.pairs.iter().enumerate() {
+            let field = || format!("broad_phase.pairs[{k}].b");
+            check_index(e.b, slots, (field, "proxy"))?;
+            ensure(e.a < e.b, || {
+                format!("broad_phase.pairs[{k}]: proxies {} and {}", e.a, e.b)
+            })?;
+            if bit(&self.moved, e.a) || bit(&self.moved, e.b) {
+                continue;
+            }
+            let (p, q) = (&self.proxies[e.a as usize], &self.proxies[e.b as usize]);
+            let now = PairEntry::new(e.a, p.user, e.b, q.user);
+            let fits = p.node != NULL && q.node != NULL && p.user != q.user && now == *e;
+            ensure(fits, || {
+                format!("broad_phase.pairs[{k}]: not a pair of live proxies")
+            })?;
+        }
+        let sorted = self.pairs.windows(2).all(|w| w[0] < w[1]);
+        ensure(sorted, || "broad_phase.pairs: not sorted".to_string())
+    }
+}
+
 impl crate::codec::Code for ProxyId {
     fn put(&self, w: &mut crate::codec::Writer) {
         self.0.put(w);

@@ -503,56 +503,98 @@ impl Tree {
     /// Checks every structural invariant; used by the tests.
     #[cfg(test)]
     pub fn validate(&self) -> Result<(), String> {
-        let mut seen = 0usize;
+        self.check_saved("tree", |_, _| true).map_err(|m| m.0)
+    }
+
+    /// Checks what every walk and edit of the tree indexes or loops over without checking,
+    /// for a tree read from a snapshot (`what` names it in errors): children and parents
+    /// in range and pointing at each other, so the tree is a tree and a walk from the root
+    /// ends; heights and inner boxes what refitting would compute (a height of `u32::MAX`
+    /// would overflow `1 +`); no NaN in a leaf's box; the leaf count; a free list that
+    /// ends, holding exactly the nodes not in the tree. `leaf(node, item)` checks each
+    /// leaf's item against the owner's records.
+    pub fn check_saved(
+        &self,
+        what: &str,
+        mut leaf: impl FnMut(u32, u32) -> bool,
+    ) -> crate::codec::Decoded<()> {
+        use crate::codec::{check_index, ensure};
+        let len = self.nodes.len();
+        // Per node: reached from the root or from the free list already.
+        let mut seen = vec![false; len];
         let mut stack = Vec::new();
         if self.root != NULL {
-            if self.nodes[self.root as usize].parent != NULL {
-                return Err("root has a parent".into());
-            }
+            check_index(self.root, len, (|| format!("{what}.root"), "node"))?;
+            let parent = self.nodes[self.root as usize].parent;
+            ensure(parent == NULL, || {
+                format!("{what}.root: has parent {parent}")
+            })?;
             stack.push(self.root);
         }
+        let mut leaves = 0usize;
         while let Some(i) = stack.pop() {
+            let at = || format!("{what}.nodes[{i}]");
+            ensure(!seen[i as usize], || format!("{}: reached twice", at()))?;
+            seen[i as usize] = true;
             let n = &self.nodes[i as usize];
             if n.is_leaf() {
-                seen += 1;
-                if n.height != 0 {
-                    return Err(format!("leaf {i} has height {}", n.height));
-                }
+                let nan = n.aabb.min.is_nan() || n.aabb.max.is_nan();
+                ensure(!nan, || format!("{}.aabb: NaN", at()))?;
+                ensure(n.height == 0, || {
+                    format!("{}: leaf of height {}", at(), n.height)
+                })?;
+                let item = n.children[1];
+                ensure(leaf(i, item), || {
+                    format!("{}: leaf of wrong item {item}", at())
+                })?;
+                leaves += 1;
                 continue;
             }
-            let [c0, c1] = n.children;
-            for c in [c0, c1] {
-                if self.nodes[c as usize].parent != i {
-                    return Err(format!("child {c} of {i} has the wrong parent"));
-                }
-            }
-            let (a, b) = (&self.nodes[c0 as usize], &self.nodes[c1 as usize]);
-            if n.aabb != a.aabb.union(&b.aabb) {
-                return Err(format!("node {i} box is not the union of its children"));
-            }
-            if n.height != 1 + a.height.max(b.height) {
-                return Err(format!("node {i} has a wrong height"));
-            }
+            self.check_inner(i, what)?;
             stack.extend_from_slice(&n.children);
         }
-        if seen != self.leaves {
-            return Err(format!("{seen} leaves reachable, {} counted", self.leaves));
-        }
-        let mut free = 0usize;
-        let mut f = self.free;
-        while f != NULL && free <= self.nodes.len() {
+        ensure(leaves == self.leaves, || {
+            format!("{what}.leaves: {} but {leaves} reached", self.leaves)
+        })?;
+        let (mut free, mut f) = (0usize, self.free);
+        while f != NULL {
+            check_index(f, len, (|| format!("{what}.free"), "node"))?;
+            ensure(!seen[f as usize], || {
+                format!("{what}.free: node {f} is in use")
+            })?;
+            seen[f as usize] = true;
             free += 1;
             f = self.nodes[f as usize].parent;
         }
-        let inner = self.leaves.saturating_sub(1);
-        if free + self.leaves + inner != self.nodes.len() {
-            return Err(format!(
-                "{} nodes: {free} free, {} leaves, {inner} inner",
-                self.nodes.len(),
-                self.leaves
-            ));
+        ensure(seen.iter().all(|&s| s), || {
+            format!("{what}: {len} nodes but {free} free and the rest not all in the tree")
+        })
+    }
+
+    /// Checks inner node `i` for [`Tree::check_saved`]: two distinct children in range
+    /// whose parent it is, its height and its box as `refit` computes them.
+    fn check_inner(&self, i: u32, what: &str) -> crate::codec::Decoded<()> {
+        use crate::codec::{check_index, ensure};
+        let at = || format!("{what}.nodes[{i}]");
+        let n = &self.nodes[i as usize];
+        let [c0, c1] = n.children;
+        for (k, c) in [c0, c1].into_iter().enumerate() {
+            let field = || format!("{}.children[{k}]", at());
+            check_index(c, self.nodes.len(), (field, "node"))?;
+            let parent = self.nodes[c as usize].parent;
+            ensure(parent == i, || {
+                format!("{}: child {c} has parent {parent}", at())
+            })?;
         }
-        Ok(())
+        ensure(c0 != c1, || format!("{}: child {c0} twice", at()))?;
+        let (a, b) = (&self.nodes[c0 as usize], &self.nodes[c1 as usize]);
+        let height = 1 + a.height.max(b.height) as u64;
+        ensure(n.height as u64 == height, || {
+            format!("{}: height {} but {height} by its children", at(), n.height)
+        })?;
+        ensure(n.aabb == a.aabb.union(&b.aabb), || {
+            format!("{}.aabb: not the union of its children's", at())
+        })
     }
 }
 

@@ -320,6 +320,14 @@ pub fn reduce(candidates: &[Candidate], margin: Real, out: &mut Manifold) {
     }
 }
 
+impl Manifold {
+    /// Whether a manifold read from a snapshot holds at most [`MAX_MANIFOLD_POINTS`]
+    /// points: `points()` slices the array by the count.
+    pub(crate) fn count_fits(&self) -> bool {
+        self.count as usize <= MAX_MANIFOLD_POINTS
+    }
+}
+
 crate::codec::codec_struct!(ContactPoint {
     point_a,
     point_b,

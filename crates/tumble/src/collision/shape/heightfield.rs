@@ -34,52 +34,25 @@ impl HeightField {
     /// Builds a height field from `rows × cols` heights (row-major); needs at least 2 × 2
     /// samples, finite heights and a positive scale.
     pub fn new(heights: Vec<Real>, rows: usize, cols: usize, scale: Vec3) -> Result<HeightField> {
-        if rows < 2 || cols < 2 {
-            return Err(Error::invalid(
-                "heights",
-                format!("needs at least 2 rows and 2 columns (got {rows} × {cols})"),
-            ));
-        }
-        if rows.checked_mul(cols) != Some(heights.len()) {
-            return Err(Error::invalid(
-                "heights",
-                format!(
-                    "must hold rows × cols = {rows} × {cols} values (got {})",
-                    heights.len()
-                ),
-            ));
-        }
-        // Triangle indices are reported as u32.
-        if (rows - 1).saturating_mul(cols - 1) > (u32::MAX / 2) as usize {
-            return Err(Error::invalid(
-                "heights",
-                "too many cells (at most 2^31 triangles)",
-            ));
-        }
-        check::positive_vec3("scale", scale)?;
-        let mut range = (Real::INFINITY, Real::NEG_INFINITY);
-        for (k, &h) in heights.iter().enumerate() {
-            // Scaled heights must stay finite too, or the surface would hold infinities.
-            if !(h * scale.y).is_finite() {
-                return Err(Error::invalid(
-                    format!("heights[{k}]"),
-                    "must be a finite number",
-                ));
-            }
-            range = (range.0.min(h * scale.y), range.1.max(h * scale.y));
-        }
-        let field = HeightField {
+        let range = checked_range(&heights, rows, cols, scale)?;
+        Ok(HeightField {
             heights,
             rows,
             cols,
             scale,
             range,
-        };
-        let b = field.local_aabb();
-        if !(b.min.x.is_finite() && b.min.z.is_finite()) {
-            return Err(Error::invalid("scale", "makes the grid infinitely wide"));
+        })
+    }
+
+    /// Checks a height field read from a snapshot as [`HeightField::new`] checks its input
+    /// (every sample and cell index is computed from `rows` and `cols`), and its range as
+    /// `new` computes it.
+    pub(crate) fn check_saved(&self) -> Result<()> {
+        let range = checked_range(&self.heights, self.rows, self.cols, self.scale)?;
+        if range != self.range {
+            return Err(Error::invalid("range", "is not the heights' range"));
         }
-        Ok(field)
+        Ok(())
     }
 
     /// Number of rows (along z).
@@ -371,6 +344,50 @@ mod tests {
         assert_eq!(f.height_at(0.0, -0.5), Some(1.0));
         assert_eq!(f.height_at(0.5, 0.0), Some(3.0));
     }
+}
+
+/// [`HeightField::new`]'s checks of its input, and the lowest and highest scaled height.
+fn checked_range(heights: &[Real], rows: usize, cols: usize, scale: Vec3) -> Result<(Real, Real)> {
+    if rows < 2 || cols < 2 {
+        return Err(Error::invalid(
+            "heights",
+            format!("needs at least 2 rows and 2 columns (got {rows} × {cols})"),
+        ));
+    }
+    if rows.checked_mul(cols) != Some(heights.len()) {
+        return Err(Error::invalid(
+            "heights",
+            format!(
+                "must hold rows × cols = {rows} × {cols} values (got {})",
+                heights.len()
+            ),
+        ));
+    }
+    // Triangle indices are reported as u32.
+    if (rows - 1).saturating_mul(cols - 1) > (u32::MAX / 2) as usize {
+        return Err(Error::invalid(
+            "heights",
+            "too many cells (at most 2^31 triangles)",
+        ));
+    }
+    check::positive_vec3("scale", scale)?;
+    let mut range = (Real::INFINITY, Real::NEG_INFINITY);
+    for (k, &h) in heights.iter().enumerate() {
+        // Scaled heights must stay finite too, or the surface would hold infinities.
+        if !(h * scale.y).is_finite() {
+            return Err(Error::invalid(
+                format!("heights[{k}]"),
+                "must be a finite number",
+            ));
+        }
+        range = (range.0.min(h * scale.y), range.1.max(h * scale.y));
+    }
+    let hx = (cols - 1) as Real * 0.5 * scale.x;
+    let hz = (rows - 1) as Real * 0.5 * scale.z;
+    if !(hx.is_finite() && hz.is_finite()) {
+        return Err(Error::invalid("scale", "makes the grid infinitely wide"));
+    }
+    Ok(range)
 }
 
 crate::codec::codec_struct!(HeightField {

@@ -241,6 +241,23 @@ impl Shape {
         }
     }
 
+    /// Checks a shape read from a snapshot: its numbers as [`Shape::validate`] checks
+    /// them, and the indices a hull, mesh or height field holds (checked when built, but
+    /// read back they are whatever the bytes say), in compounds' children too.
+    pub(crate) fn check_saved(&self) -> Result<()> {
+        self.validate()?;
+        match self {
+            Shape::ConvexHull(hull) => hull.check_saved(),
+            Shape::TriMesh(mesh) => mesh.check_saved(),
+            Shape::HeightField(field) => field.check_saved(),
+            Shape::Compound(children) => children.iter().enumerate().try_for_each(|(i, c)| {
+                let at = format!("children[{i}].shape");
+                c.shape.check_saved().map_err(|e| e.within(&at))
+            }),
+            _ => Ok(()),
+        }
+    }
+
     /// Mass, centre of mass and inertia tensor (about the centre of mass, in the shape's
     /// frame) for a uniform `density` (kg/m³). The shape must be valid. Static-only shapes
     /// have no volume; they report a unit placeholder that nothing integrates.

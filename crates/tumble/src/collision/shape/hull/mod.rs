@@ -85,6 +85,44 @@ impl ConvexHull {
         Ok(assemble(points, &pts, &tris, &polygons))
     }
 
+    /// Checks a hull read from a snapshot: what collision and mass code index without
+    /// checking (built, it holds by construction). Finite vertices, at least one; every
+    /// triangle, face loop and edge naming vertices that exist; one plane per face loop,
+    /// each loop a polygon.
+    pub(crate) fn check_saved(&self) -> Result<()> {
+        let n = self.vertices.len();
+        let bad = |field: String, reason: String| Err(Error::invalid(field, reason));
+        if n == 0 || self.triangles.is_empty() || self.planes.is_empty() {
+            return bad("vertices".into(), "an empty hull".into());
+        }
+        if let Some(i) = self.vertices.iter().position(|v| !v.is_finite()) {
+            return bad(format!("vertices[{i}]"), "must be finite numbers".into());
+        }
+        let out = |k: &u32| *k as usize >= n;
+        if let Some(i) = self.triangles.iter().position(|t| t.iter().any(out)) {
+            return bad(format!("triangles[{i}]"), format!("a vertex out of {n}"));
+        }
+        if let Some(i) = self.edges.iter().position(|e| e.iter().any(out)) {
+            return bad(format!("edges[{i}]"), format!("a vertex out of {n}"));
+        }
+        let faces = self.planes.len();
+        if self.face_loops.len() != faces {
+            let loops = self.face_loops.len();
+            return bad(
+                "face_loops".into(),
+                format!("{loops} loops for {faces} planes"),
+            );
+        }
+        let polygon = |l: &Vec<u32>| l.len() >= 3 && !l.iter().any(out);
+        if let Some(i) = self.face_loops.iter().position(|l| !polygon(l)) {
+            return bad(
+                format!("face_loops[{i}]"),
+                format!("not a polygon of {n} vertices"),
+            );
+        }
+        Ok(())
+    }
+
     /// The hull's vertices (a subset of the input points, in input order).
     pub fn vertices(&self) -> &[Vec3] {
         &self.vertices

@@ -145,6 +145,62 @@ impl TriMesh {
         Ok(mesh)
     }
 
+    /// Checks a mesh read from a snapshot: what its queries index without checking (built,
+    /// it holds by construction). Vertices finite; at least one triangle, its corners,
+    /// neighbours and per-triangle lists in range; a hierarchy whose root exists, whose
+    /// leaves slice `order` within it and whose inner nodes' children come after them (so
+    /// a walk ends), and an `order` of triangles that exist.
+    pub(crate) fn check_saved(&self) -> Result<()> {
+        let (vertices, triangles) = (self.vertices.len(), self.indices.len());
+        let bad = |field: String, reason: String| Err(Error::invalid(field, reason));
+        if let Some(i) = self.vertices.iter().position(|v| !v.is_finite()) {
+            return bad(format!("vertices[{i}]"), "must be finite numbers".into());
+        }
+        let lists = [self.normals.len(), self.neighbors.len(), self.bends.len()];
+        if triangles == 0 || lists.iter().any(|&n| n != triangles) {
+            return bad(
+                "indices".into(),
+                format!("{triangles} triangles, lists {lists:?}"),
+            );
+        }
+        let outside = |t: &[u32; 3]| t.iter().any(|&k| k as usize >= vertices);
+        if let Some(i) = self.indices.iter().position(outside) {
+            return bad(
+                format!("indices[{i}]"),
+                format!("a vertex out of {vertices}"),
+            );
+        }
+        let next = |n: &[Option<u32>; 3]| n.iter().flatten().any(|&t| t as usize >= triangles);
+        if let Some(i) = self.neighbors.iter().position(next) {
+            return bad(
+                format!("neighbors[{i}]"),
+                format!("a triangle out of {triangles}"),
+            );
+        }
+        if let Some(i) = self.order.iter().position(|&t| t as usize >= triangles) {
+            return bad(
+                format!("order[{i}]"),
+                format!("a triangle out of {triangles}"),
+            );
+        }
+        let (nodes, order) = (self.nodes.len() as u64, self.order.len() as u64);
+        let fits = |(i, n): (usize, &Node)| {
+            let first = n.first as u64;
+            if n.count > 0 {
+                first + n.count as u64 <= order
+            } else {
+                first > i as u64 && first + 1 < nodes
+            }
+        };
+        if let Some(i) = self.nodes.iter().enumerate().position(|x| !fits(x)) {
+            return bad(format!("nodes[{i}]"), "out of the hierarchy".into());
+        }
+        if nodes == 0 {
+            return bad("nodes".into(), "empty".into());
+        }
+        Ok(())
+    }
+
     /// Whether [`TriMesh::new`] takes the triangle `a b c`: one of non-zero area by its
     /// test (no two edges parallel to rounding), so that importers can drop the others
     /// (sliver faces of exported meshes) before building.
