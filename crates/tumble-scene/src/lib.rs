@@ -79,8 +79,11 @@ const TOP_KEYS: [&str; 27] = [
     "exclude",
 ];
 
-/// The most `substeps` and `iterations` a scene or the command line may ask for.
-pub const MAX_PASSES: u32 = 1_000_000;
+/// The most `substeps` and `iterations` a scene or the command line may ask for: the
+/// engine's own bound (`tumble::limits`), so that a scene the loader passes is one the
+/// world takes.
+pub const MAX_PASSES: u32 = tumble::limits::MAX_SUBSTEPS;
+const _: () = assert!(tumble::limits::MAX_ITERATIONS == MAX_PASSES);
 
 /// Default step (s).
 pub const DEFAULT_DT: Real = 0.01;
