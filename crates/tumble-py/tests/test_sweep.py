@@ -117,6 +117,15 @@ def test_bad_paths_give_loader_style_errors():
         tumble.sweep("nope", {"dt": [0.1]}, metrics, use_ray=False)
     with pytest.raises(ValueError, match=r"^metric: unknown metric 'ball.height'"):
         tumble.sweep(SCENE, {"dt": [0.1]}, ["ball.height"], use_ray=False)
+    # The grid's own shape: a dict of path -> list of values.
+    with pytest.raises(TypeError, match=r"^grid: must be a dict of path -> list of values, got list$"):
+        run([("dt", [0.1])])
+    with pytest.raises(TypeError, match=r"^grid: keys must be paths \(str\), got int$"):
+        run({3: [0.1]})
+    with pytest.raises(TypeError, match=r"^grid\['dt'\]: must be a list of values, got str$"):
+        run({"dt": "0.1"})
+    with pytest.raises(ValueError, match=r"^grid\['dt'\]: must hold at least one value$"):
+        run({"dt": []})
     # An unknown key is the loader's error, for that run only.
     rows = records(tumble.sweep(SCENE, {"bodies[ball].bounce": [1]}, metrics, use_ray=False, progress=False))
     assert rows[0]["error"].startswith("bodies[1].bounce: unknown key")

@@ -280,6 +280,11 @@ def _steps(world, duration: Optional[float]) -> int:
 
 def combinations(grid: Mapping[str, Iterable[Any]]) -> list:
     """Every combination of the grid's values, the first parameter varying slowest."""
+    if not isinstance(grid, Mapping):
+        raise TypeError(f"grid: must be a dict of path -> list of values, got {type(grid).__name__}")
+    for p in grid:
+        if not isinstance(p, str):
+            raise TypeError(f"grid: keys must be paths (str), got {type(p).__name__}")
     paths = list(grid)
     values = []
     for p in paths:
