@@ -282,7 +282,7 @@ impl Sweeps<'_> {
     ) -> Option<(Impact, Option<usize>)> {
         let body = &self.bodies[i];
         let mut first: Option<(Impact, Option<usize>)> = None;
-        self.broad.query_aabb(&swept_region(body, sweep), |user| {
+        let visit = |user: u32| {
             let j = user as usize;
             let Some(other) = self.bodies.get(j) else {
                 return;
@@ -315,7 +315,15 @@ impl Sweeps<'_> {
             if let Some(hit) = sweep_shapes(&body.shape, sweep, &other.shape, &path, stop, limit) {
                 first = Some((hit, moving.then_some(j)));
             }
-        });
+        };
+        // Only a bullet is stopped by moving bodies: any other needs the static tree alone
+        // (walking the moving one for nothing was half the sweep of a swinging pole).
+        let region = swept_region(body, sweep);
+        if body.bullet {
+            self.broad.query_aabb(&region, visit);
+        } else {
+            self.broad.query_static_aabb(&region, visit);
+        }
         first
     }
 }
