@@ -219,9 +219,23 @@ const ZERO_MOTION: Motion = Motion {
 /// position and half-step angular momentum, per body. Lasting state of the world (a
 /// snapshot must keep it); every edit that breaks the sequence of equal steps it assumes
 /// forgets it: a body edited from outside, a body the solver moved, a change of method.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Default)]
 pub(crate) struct IntegratorMemory {
     verlet: Vec<Option<VerletMemory>>,
+}
+
+// By hand for `clone_from` in place: the world keeps a copy every step to undo a failed
+// one, and the derived one allocated a new list each time.
+impl Clone for IntegratorMemory {
+    fn clone(&self) -> Self {
+        IntegratorMemory {
+            verlet: self.verlet.clone(),
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.verlet.clone_from(&source.verlet);
+    }
 }
 
 impl IntegratorMemory {

@@ -128,7 +128,7 @@ pub enum JointKind {
 // or free axis are new (`dynamics/solver/joint_rows.rs`).
 
 /// Everything needed to create a joint.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct JointDef {
     /// An optional unique name (scene files refer to joints by it).
     pub name: Option<String>,
@@ -158,6 +158,40 @@ pub struct JointDef {
     pub armature: Real,
 }
 
+// Clone by hand for `clone_from` in place: the world copies its joints every step (to
+// undo a failed one), and the derived `clone_from` cloned each name, an allocation a
+// named joint a step. Every field but the name is `Copy`.
+impl Clone for JointDef {
+    fn clone(&self) -> Self {
+        JointDef {
+            name: self.name.clone(),
+            ..*self
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        let mut name = self.name.take();
+        name.clone_from(&source.name);
+        *self = JointDef { name, ..*source };
+    }
+}
+
+impl Clone for Joint {
+    fn clone(&self) -> Self {
+        Joint {
+            def: self.def.clone(),
+            ..*self
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        let placeholder = JointDef::new(source.def.kind, source.def.body);
+        let mut def = std::mem::replace(&mut self.def, placeholder);
+        def.clone_from(&source.def);
+        *self = Joint { def, ..*source };
+    }
+}
+
 impl JointDef {
     /// A joint of `kind` on `body`, anchored at its origin, to the world at the origin,
     /// with both axes along x.
@@ -179,7 +213,7 @@ impl JointDef {
 }
 
 /// A joint as the world keeps it.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct Joint {
     pub(crate) def: JointDef,
     /// Unit axes in each frame (other: world frame when joined to the world).

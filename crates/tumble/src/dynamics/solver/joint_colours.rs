@@ -57,26 +57,29 @@ impl JointRun {
 }
 
 /// Sorts `joints` colour by colour within each of `parts` (consecutive ranges covering
-/// the list), renumbers the `chains`' members to match, and returns the runs. `used` is
-/// scratch, one mask of colours per body of the step (`bodies` of them).
+/// the list), renumbers the `chains`' members to match, and makes `runs` the runs. `used`
+/// is scratch, one mask of colours per body of the step (`bodies` of them).
 pub(super) fn order(
     joints: &mut [JointConstraint],
     chains: &mut [Chain],
     parts: [Range<usize>; 2],
     (bodies, used): (usize, &mut Vec<u64>),
-) -> Vec<JointRun> {
-    // One stripe a part: solved as they were, in creation order with their chains.
-    let serial = |parts: &[Range<usize>]| {
+    runs: &mut Vec<JointRun>,
+) {
+    // One stripe a part: solved as they were, in creation order with their chains. The
+    // list is refilled in place (a small world's step comes here every time).
+    let serial = |parts: &[Range<usize>], runs: &mut Vec<JointRun>| {
         let run = |part: &Range<usize>| JointRun {
             range: part.clone(),
             stripes: Vec::new(),
         };
-        parts.iter().filter(|p| !p.is_empty()).map(run).collect()
+        runs.clear();
+        runs.extend(parts.iter().filter(|p| !p.is_empty()).map(run));
     };
     // Parts no longer than a stripe need no look at their joints (reading them was most
     // of this function's 1.5 % of the f32 joint grid's step).
     if parts.iter().all(|part| part.len() <= STRIPE) {
-        return serial(&parts);
+        return serial(&parts, runs);
     }
     // Each joint's bodies, and whether it is a chain's member, read once: the walks below
     // over the few-hundred-byte constraints cost the joint grid 1.7 % of its step.
@@ -86,7 +89,7 @@ pub(super) fn order(
         .collect();
     let free = |part: &Range<usize>| info[part.clone()].iter().filter(|l| !l.1).count();
     if parts.iter().all(|part| free(part) <= STRIPE) {
-        return serial(&parts);
+        return serial(&parts, runs);
     }
     used.clear();
     used.resize(bodies, 0);
@@ -137,7 +140,7 @@ pub(super) fn order(
             }
         }
     }
-    let mut runs: Vec<JointRun> = Vec::new();
+    runs.clear();
     for (new, &old) in moved.iter().enumerate() {
         let (part, colour, stripe) = key[old];
         match runs.last_mut() {
@@ -160,7 +163,6 @@ pub(super) fn order(
             }),
         }
     }
-    runs
 }
 
 /// Puts at each position `new` the joint that was at `moved[new]`, in place: cycle by

@@ -681,13 +681,17 @@ impl Solver {
         self.tall_contacts = order.partition_point(|&(part, _, _)| part < Part::Tall as u8);
         // Each constraint's first point: the constraints and their points are written in
         // place, in pieces on the step's team, so the lists take their final lengths first.
-        let mut firsts = Vec::with_capacity(order.len() + 1);
+        // (None without contacts: a jointed world's step allocates nothing here.)
+        let mut firsts = Vec::new();
         let mut total = 0;
-        for &(_, _, i) in &order {
+        if !order.is_empty() {
+            firsts.reserve_exact(order.len() + 1);
+            for &(_, _, i) in &order {
+                firsts.push(total);
+                total += contacts[i].manifold.len();
+            }
             firsts.push(total);
-            total += contacts[i].manifold.len();
         }
-        firsts.push(total);
         // Every entry is overwritten whole below, so only a list's growth is written
         // now (cleared and refilled with defaults, the lists' writes were 4 % of the
         // pyramid's step).
@@ -858,11 +862,12 @@ impl Solver {
         self.chains = find_chains(&mut self.joints, &solver_bodies.sims, &mut self.chain_lists);
         self.armatures = self.joints.iter().any(|j| j.has_armature());
         let (n, heavy) = (self.joints.len(), self.heavy_joints);
-        self.joint_runs = joint_colours::order(
+        joint_colours::order(
             &mut self.joints,
             &mut self.chains,
             [0..heavy, heavy..n],
             (solver_bodies.sims.len(), &mut self.joint_used),
+            &mut self.joint_runs,
         );
         self.chain_blocks.clear();
         self.chain_blocks.resize(self.chains.len(), None);

@@ -129,21 +129,20 @@ impl World {
     /// Re-derives each joint's dense body indices (broken and disabled joints join
     /// nothing) and the pairs that must not collide (those joints and the excluded pairs).
     pub(crate) fn refresh_joint_links(&mut self) {
-        let links: Vec<[Option<usize>; 2]> = self
-            .joints
-            .list
-            .iter()
-            .map(|j| {
-                if !j.acts() {
-                    [None, None]
-                } else {
-                    [
-                        self.dense(j.def.body),
-                        j.def.other.and_then(|o| self.dense(o)),
-                    ]
-                }
-            })
-            .collect();
+        // The list is refilled in place: this runs every step.
+        let mut links = std::mem::take(&mut self.joints.links);
+        links.clear();
+        let found = self.joints.list.iter().map(|j| {
+            if !j.acts() {
+                [None, None]
+            } else {
+                [
+                    self.dense(j.def.body),
+                    j.def.other.and_then(|o| self.dense(o)),
+                ]
+            }
+        });
+        links.extend(found);
         self.joints.joined_pairs.clear();
         for (j, link) in self.joints.list.iter().zip(&links) {
             if let [Some(a), Some(b)] = *link {
