@@ -328,8 +328,7 @@ impl JointConstraint {
     ) -> Option<&'b Block> {
         let slot = blocks.slot(self.block?);
         if !slot.ready {
-            self.hard_rows(fr, &mut slot.hard)?;
-            slot.eliminate(fr);
+            slot.refresh(fr, |hard| self.hard_rows(fr, hard))?;
         }
         Some(slot)
     }

@@ -855,9 +855,9 @@ impl Solver {
             j.block = Some(blocks);
             blocks += 1;
         }
-        // Kept from step to step (a block is a kilobyte): only marked out of date.
+        // Kept from step to step (a block is a kilobyte): only marked out of date, and
+        // carried (see `Block::refresh`), once the frames are made below.
         self.joint_blocks.truncate(blocks);
-        self.joint_blocks.iter_mut().for_each(|b| b.ready = false);
         self.joint_blocks.resize_with(blocks, JointBlock::default);
         self.chains = find_chains(&mut self.joints, &solver_bodies.sims, &mut self.chain_lists);
         self.armatures = self.joints.iter().any(|j| j.has_armature());
@@ -872,6 +872,11 @@ impl Solver {
         self.chain_blocks.clear();
         self.chain_blocks.resize(self.chains.len(), None);
         self.make_joint_frames(&solver_bodies.sims);
+        // (After: `make_joint_frames` clears `carried`, and not `ready` when the joints'
+        // count changed.)
+        self.joint_blocks
+            .iter_mut()
+            .for_each(|b| (b.ready, b.carried) = (false, true));
     }
 
     /// Each joint's frame at the poses in `sims`; after each drift of the bodies outside
@@ -896,7 +901,9 @@ impl Solver {
                 }
             },
         );
-        self.joint_blocks.iter_mut().for_each(|b| b.ready = false);
+        self.joint_blocks
+            .iter_mut()
+            .for_each(|b| (b.ready, b.carried) = (false, false));
         self.chain_blocks.fill(None);
     }
 
