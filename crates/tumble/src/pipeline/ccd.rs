@@ -141,6 +141,11 @@ pub(crate) fn sweep_fast_bodies(
     (slop, margin): (Real, Real),
 ) {
     fast.clear();
+    // Nothing a sweep could meet: no static body, and no bullet (only a bullet meets
+    // moving bodies). A jointed world without ground skips the sweeps' setup.
+    if broad.has_no_static() && !bodies.iter().any(|b| b.bullet) {
+        return;
+    }
     let sims = &solver_bodies.sims;
     fast.extend(bodies.iter().zip(sims).map(|(b, s)| is_fast(b, s)));
     if !fast.contains(&true) {

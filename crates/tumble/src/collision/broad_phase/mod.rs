@@ -488,6 +488,11 @@ impl BroadPhase {
         self.len() == 0
     }
 
+    /// True with no static proxy (nothing `query_static_aabb` could find).
+    pub fn has_no_static(&self) -> bool {
+        self.trees[tree_index(ProxyKind::Static)].is_empty()
+    }
+
     /// The enlarged box stored for a proxy (what pairs and queries test), `None` for an
     /// unknown or removed id. A tight box with a NaN in it is stored as the empty box
     /// (min +∞, max −∞), which overlaps only a box infinite both ways on every axis.

@@ -208,6 +208,11 @@ impl Tree {
         self.root().map_or(0, |r| self.nodes[r as usize].height)
     }
 
+    /// True with no leaf.
+    pub fn is_empty(&self) -> bool {
+        self.root == NULL
+    }
+
     /// Calls `f(item)` for every leaf whose box overlaps `aabb`. `stack` is scratch space,
     /// passed in so repeated queries reuse one allocation.
     pub fn query(&self, aabb: &Aabb, stack: &mut Vec<u32>, mut f: impl FnMut(u32)) {
