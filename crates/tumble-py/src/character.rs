@@ -6,10 +6,13 @@ use std::sync::{Mutex, MutexGuard, TryLockError};
 use numpy::PyArray1;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
-use tumble::{CharacterController, CharacterDef, QueryFilter, Real, Vec3};
+use pyo3::types::PyDict;
+use tumble::{CharacterController, CharacterDef, Ground, QueryFilter, Real, Vec3};
 
 use crate::body::{handle, PyBody};
-use crate::convert::{engine, layer_bits, real, vec3, vec3_or, vec3_out, wide};
+use crate::convert::{
+    engine, invalid, layer_bits, real, vec3, vec3_or, vec3_out, wide, wrong_type,
+};
 use crate::world::{body_arg, PyWorld};
 
 /// A character controller: a kinematic capsule that walks in `world`.
@@ -235,6 +238,83 @@ impl PyCharacter {
     #[getter]
     fn up<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         Ok(vec3_out(py, self.read(|c| c.def().up)?))
+    }
+
+    /// What the character carries from one move to the next, as a dict: `position` and
+    /// `velocity` (3,) arrays and `ground` (None in the air, else a dict of `body` (a
+    /// Body), `point` and `normal`). With `World.snapshot`, what a saved run needs: after
+    /// `world.restore(snap)`, `restore(state)` puts the character back, and its next move
+    /// goes on as it would have.
+    fn state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let (position, velocity, ground) =
+            self.read(|c| (c.position(), c.velocity(), c.ground()))?;
+        let d = PyDict::new(py);
+        d.set_item("position", vec3_out(py, position))?;
+        d.set_item("velocity", vec3_out(py, velocity))?;
+        let ground = match ground {
+            None => None,
+            Some(g) => {
+                let gd = PyDict::new(py);
+                gd.set_item("body", handle(self.world.bind(py), g.body)?)?;
+                gd.set_item("point", vec3_out(py, g.point))?;
+                gd.set_item("normal", vec3_out(py, g.normal))?;
+                Some(gd)
+            }
+        };
+        d.set_item("ground", ground)?;
+        Ok(d)
+    }
+
+    /// Puts the character back to `state` (a dict as `state()` returns; `velocity` and
+    /// `ground` may be left out: zero, in the air). Refused, nothing changed, with the
+    /// key named (`state.ground.body: this body was removed`) for a value of the wrong
+    /// type or shape, a position beyond the world's range, a ground body the world does
+    /// not hold or a ground normal that is not a unit vector.
+    fn restore<'py>(&self, state: &Bound<'py, PyAny>) -> PyResult<()> {
+        fn item<'py>(d: &Bound<'py, PyDict>, key: &str) -> Option<Bound<'py, PyAny>> {
+            d.get_item(key).ok().flatten()
+        }
+        let state = state
+            .cast::<PyDict>()
+            .map_err(|_| wrong_type("state", "a dict", state))?;
+        let known = ["position", "velocity", "ground"];
+        for key in state.keys() {
+            let name: String = key.extract().unwrap_or_else(|_| key.to_string());
+            if !known.contains(&name.as_str()) {
+                return Err(invalid(&format!("state.{name}"), "unknown key"));
+            }
+        }
+        let position = item(state, "position")
+            .ok_or_else(|| invalid("state.position", "required"))
+            .and_then(|p| vec3(&p, "state.position"))?;
+        let velocity = vec3_or(
+            item(state, "velocity").as_ref(),
+            "state.velocity",
+            Vec3::ZERO,
+        )?;
+        let world = self.world.get();
+        let inner = world.lock()?;
+        let ground = match item(state, "ground").filter(|g| !g.is_none()) {
+            None => None,
+            Some(g) => {
+                let g = g
+                    .cast::<PyDict>()
+                    .map_err(|_| wrong_type("state.ground", "a dict or None", &g))?;
+                let field = |key: &str| {
+                    item(g, key).ok_or_else(|| invalid(&format!("state.ground.{key}"), "required"))
+                };
+                let body = field("body")?;
+                let bound = self.world.bind(g.py());
+                Some(Ground {
+                    body: body_arg(bound, &inner, &body, "state.ground.body")?,
+                    point: vec3(&field("point")?, "state.ground.point")?,
+                    normal: vec3(&field("normal")?, "state.ground.normal")?,
+                })
+            }
+        };
+        let mut c = self.lock()?;
+        c.restore(&inner.world, position, ground, velocity)
+            .map_err(|e| engine(e.within("state")))
     }
 
     fn __repr__(&self) -> PyResult<String> {

@@ -8,6 +8,7 @@ impulses, and every bad argument refused naming its field.
 """
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -181,3 +182,63 @@ def test_the_course_scene_is_a_builtin_and_its_walker_a_body():
     walker = world.body("walker")
     assert walker.kind == "kinematic"
     assert (walker.collision_group, walker.collision_mask) == (0, 0)
+
+
+@pytest.mark.parametrize("dt", [1 / 60, 1 / 240])
+def test_a_saved_run_continues_as_the_run_that_never_stopped(dt):
+    # A world with a box to walk onto and a dynamic crate to push; the walker's state is
+    # saved with the world's snapshot mid-run, and the saved run, restored into the same
+    # world and controller after they went on elsewhere, retraces the first run exactly.
+    world = floor_world()
+    world.add_body(tumble.Box((0.5, 0.1, 2.0)), kind="static", position=(2.0, 0.1, 0.0))
+    world.add_body(tumble.Box((0.2, 0.2, 0.2)), mass=2.0, position=(4.0, 0.2, 0.0))
+    c = tumble.CharacterController(world, position=(0.0, 0.95, 0.0))
+
+    def run(steps):
+        out = []
+        for k in range(steps):
+            p = walk(c, (1.5, 0.0, 0.1 * math.sin(k * dt * 3)), dt, 1)[-1]
+            world.step(dt)
+            out.append((p.copy(), world.state_hash(), c.on_ground))
+        return out
+
+    run(int(1.0 / dt))
+    snap, state = world.snapshot(), c.state()
+    assert state["ground"] is not None  # (the box's edge, climbing onto it)
+    first = run(int(2.0 / dt))
+    assert first[-1][0][0] > 3.0, "walked onto the box and on to the crate"
+    world.restore(snap)
+    c.restore(state)
+    second = run(int(2.0 / dt))
+    for (p1, h1, g1), (p2, h2, g2) in zip(first, second):
+        assert np.array_equal(p1, p2) and h1 == h2 and g1 == g2
+
+
+def test_restore_refuses_bad_states_naming_the_key_and_changes_nothing():
+    world = floor_world()
+    c = tumble.CharacterController(world, position=(0.0, 0.95, 0.0))
+    c.move((0.0, -0.1, 0.0), 1 / 60)
+    good = c.state()
+    assert good["ground"] is not None
+    other = floor_world()
+    stranger = other.add_body(tumble.Sphere(0.1), position=(0, 5, 0))
+    ground = dict(good["ground"])
+    cases = [
+        (TypeError, "state: expected a dict", [1, 2, 3]),
+        (ValueError, "state.position: required", {"velocity": [0, 0, 0]}),
+        (ValueError, "state.colour: unknown key", dict(good, colour=1)),
+        (ValueError, "state.position", dict(good, position=[0, 1])),
+        (ValueError, "state.velocity", dict(good, velocity=[0, float("nan"), 0])),
+        (TypeError, "state.ground: expected a dict or None", dict(good, ground=3)),
+        (ValueError, "state.ground.normal: required", dict(good, ground={"body": ground["body"], "point": [0, 0, 0]})),
+        (ValueError, "state.ground.normal: must be a unit vector", dict(good, ground=dict(ground, normal=[0, 2, 0]))),
+        (ValueError, "state.ground.body: this body belongs to another world", dict(good, ground=dict(ground, body=stranger))),
+        (ValueError, "state.position: ", dict(good, position=[1e300, 0, 0])),
+    ]
+    for error, text, bad in cases:
+        with pytest.raises(error, match="^" + re.escape(text)):
+            c.restore(bad)
+        assert np.array_equal(c.position, good["position"]) and c.on_ground
+    # Velocity and ground may be left out: at rest, in the air.
+    c.restore({"position": [0.0, 3.0, 0.0]})
+    assert not c.on_ground and np.array_equal(c.velocity, [0, 0, 0])

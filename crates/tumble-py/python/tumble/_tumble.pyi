@@ -1,7 +1,7 @@
 """Type stubs of the extension module behind `import tumble` (crates/tumble-py/src)."""
 
 from os import PathLike
-from typing import Any, Callable, Literal, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Literal, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -1022,6 +1022,13 @@ class CharacterController:
     @property
     def pushes(self) -> list[Push]:
         """The impulses the last move gave dynamic bodies."""
+    def state(self) -> dict[str, Any]:
+        """What it carries between moves: ``position``, ``velocity`` and ``ground`` (None,
+        or ``{"body": Body, "point": ..., "normal": ...}``). With World.snapshot, what a
+        saved run needs: ``world.restore(snap); c.restore(state)``."""
+    def restore(self, state: Mapping[str, Any]) -> None:
+        """Puts it back to ``state`` (as ``state()`` returns; ``velocity`` and ``ground``
+        optional). Bad values raise ValueError/TypeError naming the key, nothing changed."""
     @property
     def radius(self) -> float: ...
     @property
