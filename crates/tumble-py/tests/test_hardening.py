@@ -244,6 +244,10 @@ def test_the_issues_recording_is_refused_where_it_does_not_fit():
 
 def interrupt_after(seconds):
     """Sends this process SIGINT, as Ctrl-C does, from another thread after `seconds`."""
+    # Python raises KeyboardInterrupt only if SIGINT was not ignored when it started, and
+    # a job a shell starts in the background without job control inherits it ignored (a
+    # CI run started that way failed these tests): install the handler a terminal gives.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(seconds, os.kill, (os.getpid(), signal.SIGINT))
     timer.start()
     return timer
