@@ -519,6 +519,29 @@ impl Body {
     }
 }
 
+/// A body's coefficients by their setters' rules, named as a definition names them:
+/// `[friction, restitution, gravity_scale]`, then `[rolling_resistance,
+/// torsional_friction, linear_damping, angular_damping]` (finite, within the magnitude
+/// limit, and not negative). Shared by a new body's definition and a saved body.
+fn check_coefficients(
+    [friction, restitution, gravity_scale]: [Real; 3],
+    rest: [Real; 4],
+) -> Result<()> {
+    check_friction(friction)?;
+    check_restitution(restitution)?;
+    check_gravity_scale(gravity_scale)?;
+    let fields = [
+        "rolling_resistance",
+        "torsional_friction",
+        "linear_damping",
+        "angular_damping",
+    ];
+    for (field, x) in fields.into_iter().zip(rest) {
+        check::non_negative(field, x)?;
+    }
+    Ok(())
+}
+
 fn validate_def(def: &BodyDef) -> Result<()> {
     use crate::limits::MAX_COORDINATE;
     check::vec3_at_most("position", def.position, MAX_COORDINATE, "m")?;
@@ -527,18 +550,15 @@ fn validate_def(def: &BodyDef) -> Result<()> {
     if let Some(c) = def.center_of_mass {
         check::vec3_at_most("center_of_mass", c, MAX_COORDINATE, "m")?;
     }
-    check_friction(def.friction)?;
-    check_restitution(def.restitution)?;
-    check_gravity_scale(def.gravity_scale)?;
-    for (field, x) in [
-        ("rolling_resistance", def.rolling_resistance),
-        ("torsional_friction", def.torsional_friction),
-        ("linear_damping", def.linear_damping),
-        ("angular_damping", def.angular_damping),
-    ] {
-        // Finite, within the magnitude limit, and not negative.
-        check::non_negative(field, x)?;
-    }
+    check_coefficients(
+        [def.friction, def.restitution, def.gravity_scale],
+        [
+            def.rolling_resistance,
+            def.torsional_friction,
+            def.linear_damping,
+            def.angular_damping,
+        ],
+    )?;
     match def.mass {
         MassSpec::Density(d) => check::positive("density", d),
         MassSpec::Mass(m) => check::positive("mass", m),
@@ -575,17 +595,15 @@ impl Body {
             && (0.0..=1.0).contains(&self.restitution)
             && self.gravity_scale.abs() <= crate::limits::MAX_GRAVITY_SCALE;
         if !plain {
-            check_friction(self.friction)?;
-            check_restitution(self.restitution)?;
-            check_gravity_scale(self.gravity_scale)?;
-            for (field, x) in [
-                ("rolling_resistance", self.rolling_resistance),
-                ("torsional_friction", self.torsional_friction),
-                ("linear_damping", self.linear_damping),
-                ("angular_damping", self.angular_damping),
-            ] {
-                check::non_negative(field, x)?;
-            }
+            check_coefficients(
+                [self.friction, self.restitution, self.gravity_scale],
+                [
+                    self.rolling_resistance,
+                    self.torsional_friction,
+                    self.linear_damping,
+                    self.angular_damping,
+                ],
+            )?;
         }
         if let Some(n) = self.one_way {
             check_one_way(n)?;
