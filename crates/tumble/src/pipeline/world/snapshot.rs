@@ -431,6 +431,17 @@ mod tests {
         bytes[HEADER - 8..HEADER].copy_from_slice(&sum.to_le_bytes());
     }
 
+    /// Snapshot `bytes` with the payload bytes at `edits` (positions past the header) set,
+    /// and a valid checksum written over it.
+    fn resealed_edit(mut bytes: Vec<u8>, edits: &[(prop::sample::Index, u8)]) -> Vec<u8> {
+        for (at, value) in edits {
+            let i = HEADER + at.index(bytes.len() - HEADER);
+            bytes[i] = *value;
+        }
+        reseal(&mut bytes);
+        bytes
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(300))]
 
@@ -440,14 +451,7 @@ mod tests {
         fn a_resealed_mutated_payload_never_panics_the_decoder(
             edits in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8)
         ) {
-            let good = world().snapshot();
-            let mut bytes = good.clone();
-            for (at, value) in edits {
-                let i = HEADER + at.index(bytes.len() - HEADER);
-                bytes[i] = value;
-            }
-            reseal(&mut bytes);
-            let _ = read(&bytes);
+            let _ = read(&resealed_edit(world().snapshot(), &edits));
         }
     }
 
@@ -462,13 +466,7 @@ mod tests {
         fn a_resealed_world_that_restores_never_panics_a_step(
             edits in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..4)
         ) {
-            let good = world().snapshot();
-            let mut bytes = good.clone();
-            for (at, value) in edits {
-                let i = HEADER + at.index(bytes.len() - HEADER);
-                bytes[i] = value;
-            }
-            reseal(&mut bytes);
+            let bytes = resealed_edit(world().snapshot(), &edits);
             let mut w = world();
             if w.restore(&bytes).is_ok() {
                 for _ in 0..3 {
@@ -673,12 +671,7 @@ mod tests {
         fn a_resealed_rich_world_that_restores_never_panics_a_step(
             edits in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..4)
         ) {
-            let mut bytes = rich_snapshot().to_vec();
-            for (at, value) in edits {
-                let i = HEADER + at.index(bytes.len() - HEADER);
-                bytes[i] = value;
-            }
-            reseal(&mut bytes);
+            let bytes = resealed_edit(rich_snapshot().to_vec(), &edits);
             let mut w = World::new(&WorldDef::default());
             if w.restore(&bytes).is_ok() {
                 use_every_store(&mut w);
