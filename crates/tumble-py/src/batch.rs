@@ -832,7 +832,6 @@ impl PyBatch {
 }
 
 /// A batch's recording: flat buffers of (T, W, N, ·).
-#[derive(Default)]
 struct Frames {
     /// Every `every`-th step is recorded, and the last (`steps`).
     every: u64,
