@@ -39,8 +39,8 @@ pub struct Inner {
 ///
 /// World(*, gravity=(0, -9.8, 0), integrator="symplectic_euler", solver="soft_step",
 /// substeps=4, iterations=1, contact_hertz=60.0, contact_damping_ratio=10.0,
-/// joint_hertz=1000.0, joint_damping_ratio=0.5, baumgarte=0.2, length_unit=1.0,
-/// sleep=True, max_speed=None, max_angular_speed=None, max_contacts=None,
+/// joint_hertz=1000.0, joint_damping_ratio=0.5, baumgarte=0.2, joint_trees="maximal",
+/// length_unit=1.0, sleep=True, max_speed=None, max_angular_speed=None, max_contacts=None,
 /// max_contacts_per_body=None, max_push_speed=None, threads=None). SI units throughout; quaternions
 /// are [x, y, z, w].
 /// `max_speed` (m/s) and `max_angular_speed` (rad/s) bound every body's speed (defaults
@@ -155,8 +155,9 @@ fn count(value: i64, field: &str) -> PyResult<u32> {
 
 /// Solver settings: `kind` ("soft_step" or "pgs"), `substeps` and `iterations` per step,
 /// contact stiffness `contact_hertz` (Hz) and `contact_damping_ratio`, `baumgarte` (PGS's
-/// fraction of error corrected per substep), and the joints' `joint_hertz` (Hz) and
-/// `joint_damping_ratio`. Read with `world.solver_settings`, change a copy, assign it back.
+/// fraction of error corrected per substep), the joints' `joint_hertz` (Hz) and
+/// `joint_damping_ratio`, and `joint_trees` ("maximal" or "reduced": joint trees solved in
+/// reduced coordinates). Read with `world.solver_settings`, change a copy, assign it back.
 #[pyclass(module = "tumble", name = "SolverSettings", get_all, set_all)]
 #[derive(Clone)]
 pub struct PySolverSettings {
@@ -176,6 +177,8 @@ pub struct PySolverSettings {
     joint_hertz: f64,
     /// Damping ratio of the joints' drift correction.
     joint_damping_ratio: f64,
+    /// "maximal" or "reduced": how joint trees are solved.
+    joint_trees: String,
 }
 
 impl PySolverSettings {
@@ -189,6 +192,7 @@ impl PySolverSettings {
             baumgarte: wide(s.baumgarte),
             joint_hertz: wide(s.joint_hertz),
             joint_damping_ratio: wide(s.joint_damping_ratio),
+            joint_trees: s.joint_trees.name().to_string(),
         }
     }
 
@@ -202,6 +206,7 @@ impl PySolverSettings {
             baumgarte: real(self.baumgarte),
             joint_hertz: real(self.joint_hertz),
             joint_damping_ratio: real(self.joint_damping_ratio),
+            joint_trees: tumble_scene::parse_joint_trees(&self.joint_trees).map_err(scene)?,
         })
     }
 }
@@ -211,7 +216,7 @@ impl PySolverSettings {
     #[new]
     #[pyo3(signature = (*, kind = "soft_step".to_string(), substeps = 4, iterations = 1,
         contact_hertz = 60.0, contact_damping_ratio = 10.0, baumgarte = 0.2,
-        joint_hertz = 1000.0, joint_damping_ratio = 0.5))]
+        joint_hertz = 1000.0, joint_damping_ratio = 0.5, joint_trees = "maximal".to_string()))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         kind: String,
@@ -222,6 +227,7 @@ impl PySolverSettings {
         baumgarte: f64,
         joint_hertz: f64,
         joint_damping_ratio: f64,
+        joint_trees: String,
     ) -> PyResult<Self> {
         let s = PySolverSettings {
             kind,
@@ -232,6 +238,7 @@ impl PySolverSettings {
             baumgarte,
             joint_hertz,
             joint_damping_ratio,
+            joint_trees,
         };
         s.to_core()?;
         Ok(s)
@@ -240,7 +247,8 @@ impl PySolverSettings {
     fn __repr__(&self) -> String {
         format!(
             "tumble.SolverSettings(kind={:?}, substeps={}, iterations={}, contact_hertz={}, \
-             contact_damping_ratio={}, baumgarte={}, joint_hertz={}, joint_damping_ratio={})",
+             contact_damping_ratio={}, baumgarte={}, joint_hertz={}, joint_damping_ratio={}, \
+             joint_trees={:?})",
             self.kind,
             self.substeps,
             self.iterations,
@@ -248,7 +256,8 @@ impl PySolverSettings {
             self.contact_damping_ratio,
             self.baumgarte,
             self.joint_hertz,
-            self.joint_damping_ratio
+            self.joint_damping_ratio,
+            self.joint_trees
         )
     }
 }
@@ -338,7 +347,8 @@ impl PyWorld {
     #[pyo3(signature = (*, gravity = None, integrator = "symplectic_euler".to_string(),
         solver = "soft_step".to_string(), substeps = 4, iterations = 1, contact_hertz = 60.0,
         contact_damping_ratio = 10.0, joint_hertz = 1000.0, joint_damping_ratio = 0.5,
-        baumgarte = 0.2, length_unit = 1.0, sleep = true, max_speed = None,
+        baumgarte = 0.2, joint_trees = "maximal".to_string(), length_unit = 1.0, sleep = true,
+        max_speed = None,
         max_angular_speed = None, max_contacts = None, max_contacts_per_body = None,
         max_push_speed = None, threads = None))]
     #[allow(clippy::too_many_arguments)]
@@ -353,6 +363,7 @@ impl PyWorld {
         joint_hertz: f64,
         joint_damping_ratio: f64,
         baumgarte: f64,
+        joint_trees: String,
         length_unit: f64,
         sleep: bool,
         max_speed: Option<f64>,
@@ -371,6 +382,7 @@ impl PyWorld {
             baumgarte,
             joint_hertz,
             joint_damping_ratio,
+            joint_trees,
         };
         let def = WorldDef {
             gravity: vec3_or(gravity, "gravity", Vec3::new(0.0, -9.8, 0.0))?,

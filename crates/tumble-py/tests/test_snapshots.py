@@ -70,7 +70,7 @@ def test_pickle_and_deepcopy_continue_bit_identically():
         (lambda b: b[: len(b) - 1], r"^snapshot: truncated at byte \d+$"),
         (lambda b: b[:10], r"^snapshot: truncated at byte 10$"),
         (lambda b: b[:100] + bytes([b[100] ^ 1]) + b[101:], r"^snapshot: checksum mismatch"),
-        (lambda b: b[:8] + bytes([2]) + b[9:], r"^snapshot: version 2, this build reads 4$"),
+        (lambda b: b[:8] + bytes([2]) + b[9:], r"^snapshot: version 2, this build reads 5$"),
         (lambda b: b"hello world, not a snapshot", r"^snapshot: not a Tumble snapshot"),
         (lambda b: b + b"\0", r"^snapshot: 1 bytes after the end at byte \d+$"),
     ],

@@ -32,7 +32,9 @@ use std::path::Path;
 
 use serde_json::Value;
 use tumble::limits::ContactLimits;
-use tumble::{Integrator, Real, SolverKind, SolverSettings, SpeedLimits, Vec3, World, WorldDef};
+use tumble::{
+    Integrator, JointTrees, Real, SolverKind, SolverSettings, SpeedLimits, Vec3, World, WorldDef,
+};
 
 pub use body::BODY_KINDS;
 pub use builtin::{builtin, builtin_names};
@@ -49,7 +51,7 @@ pub use body::check_name;
 
 use reader::{Node, Obj};
 
-const TOP_KEYS: [&str; 27] = [
+const TOP_KEYS: [&str; 28] = [
     "name",
     "description",
     "gravity",
@@ -66,6 +68,7 @@ const TOP_KEYS: [&str; 27] = [
     "contact_damping_ratio",
     "joint_hertz",
     "joint_damping_ratio",
+    "joint_trees",
     "length_unit",
     "sleep",
     "max_speed",
@@ -385,7 +388,7 @@ pub fn parse_solver(name: &str) -> Result<SolverKind> {
 }
 
 /// `solver`, `substeps`, `iterations`, `contact_hertz`, `contact_damping_ratio`,
-/// `joint_hertz`, `joint_damping_ratio`. Values are
+/// `joint_hertz`, `joint_damping_ratio`, `joint_trees`. Values are
 /// checked by the engine (`World::try_new`), which names the same keys.
 fn solver_settings(obj: &Obj<'_>) -> Result<SolverSettings> {
     let d = SolverSettings::default();
@@ -413,7 +416,25 @@ fn solver_settings(obj: &Obj<'_>) -> Result<SolverSettings> {
         joint_damping_ratio: obj
             .real("joint_damping_ratio")?
             .unwrap_or(d.joint_damping_ratio),
+        joint_trees: obj
+            .str("joint_trees")?
+            .map(parse_joint_trees)
+            .transpose()?
+            .unwrap_or(d.joint_trees),
         ..d
+    })
+}
+
+/// How joint trees are solved, by name, with the scene format's error for any other.
+pub fn parse_joint_trees(name: &str) -> Result<JointTrees> {
+    JointTrees::from_name(name).ok_or_else(|| {
+        SceneError::new(
+            "joint_trees",
+            format!(
+                "unknown way '{}' (expected one of: maximal, reduced)",
+                printable(name)
+            ),
+        )
     })
 }
 

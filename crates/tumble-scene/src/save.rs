@@ -148,6 +148,7 @@ fn settings(world: &World, options: &SaveOptions, top: &mut Fields) {
     top.add("contact_damping_ratio", num(solver.contact_damping_ratio));
     top.add("joint_hertz", num(solver.joint_hertz));
     top.add("joint_damping_ratio", num(solver.joint_damping_ratio));
+    top.add("joint_trees", text(solver.joint_trees.name()));
     top.add("length_unit", num(world.length_unit()));
     top.add("sleep", world.sleep_enabled().to_string());
     top.add("max_speed", num(limits.max_speed));

@@ -53,7 +53,7 @@ pub use narrow_phase::{ContactPoint, Manifold};
 pub use sensors::SensorEvent;
 pub use shape::Convex;
 pub use shape::{CompoundChild, ConvexHull, HeightField, MassProperties, Shape, TriMesh};
-pub use solver::{SolverKind, SolverSettings};
+pub use solver::{JointTrees, SolverKind, SolverSettings};
 pub use world::{bulk::BodyStates, World, WorldDef};
 pub use world_query::{QueryFilter, WorldRayHit, WorldShapeHit};
 
@@ -62,8 +62,8 @@ pub mod prelude {
     pub use crate::{
         AppliedForce, Body, BodyDef, BodyId, BodyKind, CompoundChild, ContactModification,
         ContactPair, Diagnostics, Drag, Error, Force, ForceContext, ForceId, InertiaSpec,
-        Integrator, JointDef, JointId, JointKind, JointSpring, MassSpec, Mat3, Motor, Quat, Real,
-        SensorEvent, Servo, Shape, SolverKind, SolverSettings, Spring, SpringEnd, Vec3, World,
-        WorldDef,
+        Integrator, JointDef, JointId, JointKind, JointSpring, JointTrees, MassSpec, Mat3, Motor,
+        Quat, Real, SensorEvent, Servo, Shape, SolverKind, SolverSettings, Spring, SpringEnd, Vec3,
+        World, WorldDef,
     };
 }

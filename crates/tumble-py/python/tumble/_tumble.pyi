@@ -273,6 +273,8 @@ class SolverSettings:
     baumgarte: float
     joint_hertz: float
     joint_damping_ratio: float
+    joint_trees: str
+    """"maximal" or "reduced": joint trees solved in reduced coordinates."""
     def __init__(
         self,
         *,
@@ -284,6 +286,7 @@ class SolverSettings:
         baumgarte: float = 0.2,
         joint_hertz: float = 1000.0,
         joint_damping_ratio: float = 0.5,
+        joint_trees: str = "maximal",
     ) -> None: ...
 
 class Diagnostics:
@@ -496,6 +499,7 @@ class World:
         joint_hertz: float = 1000.0,
         joint_damping_ratio: float = 0.5,
         baumgarte: float = 0.2,
+        joint_trees: str = "maximal",
         length_unit: float = 1.0,
         sleep: bool = True,
         max_speed: Optional[float] = None,

@@ -23,6 +23,7 @@ mod heavy_loads;
 mod joint_armature;
 mod joint_chains;
 mod joint_control;
+mod joint_trees;
 mod joints;
 mod kinematic_targets;
 mod mass;

@@ -359,7 +359,7 @@ fn every_kind_of_bad_snapshot_gets_its_own_error() {
     );
     let mut version = good.clone();
     version[8] = 2;
-    assert_eq!(refused(&version), "snapshot: version 2, this build reads 4");
+    assert_eq!(refused(&version), "snapshot: version 2, this build reads 5");
     let mut other = good.clone();
     let (this, that) = if std::mem::size_of::<Real>() == 8 {
         ("f64", "f32")

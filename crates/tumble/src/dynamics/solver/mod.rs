@@ -18,6 +18,7 @@
 //! integrated rotational state so that constrained bodies tumble as correctly as free ones.
 
 mod angular;
+mod articulation;
 mod body;
 mod contact;
 mod contact_wide;
@@ -30,12 +31,13 @@ mod restitution;
 mod rows;
 mod settings;
 mod softness;
+mod spatial;
 mod stacks;
 mod wide;
 
 use settings::{bias_rule, joint_passes};
+pub use settings::{JointTrees, SolverKind, SolverSettings};
 pub(crate) use settings::{Scales, StepTime};
-pub use settings::{SolverKind, SolverSettings};
 use softness::LoadSpring;
 pub use softness::Softness;
 
@@ -83,6 +85,8 @@ pub(crate) struct StepInput<'a, 'b> {
 /// Buffers reused from step to step.
 #[derive(Default)]
 pub(crate) struct Solver {
+    /// The joint trees solved in reduced coordinates this step (see `articulation.rs`).
+    trees: articulation::Articulations,
     /// The states at the step's start, for the bounce replay.
     start_states: Vec<BodyState>,
     moving: Vec<bool>,
@@ -157,6 +161,11 @@ impl Solver {
         let (world_bodies, time) = (input.system.bodies, input.time);
         self.par = input.par;
         let rule = bias_rule(input.settings, input.scales, time);
+        self.take_trees(&input, bodies, contacts);
+        if !self.trees.is_empty() && !bodies.sims.iter().any(|s| s.moves) {
+            // Every body the step solves is in a tree: nothing for the soft step.
+            return self.step_trees(&mut input, bodies);
+        }
         self.find_islands(&input, bodies, contacts);
         let fine_rule = self.fine_rule(input.settings, input.scales, time);
         let gravity = input.system.gravity;
@@ -215,7 +224,12 @@ impl Solver {
             &mut self.overlap,
         );
         self.store_contacts(contacts);
-        // ω from the final L, each body alone: on the team (3 % of the rain's step).
+        self.final_omegas(bodies, world_bodies);
+        self.finish_trees(&mut input, bodies);
+    }
+
+    /// ω from the final L, each body alone: on the team (3 % of the rain's step).
+    fn final_omegas(&self, bodies: &mut SolverBodies, world_bodies: &[Body]) {
         let work = |start: usize, sims: &mut [BodySim], states: &mut [BodyState]| {
             for (j, (sim, state)) in sims.iter_mut().zip(states).enumerate() {
                 if sim.moves {
@@ -225,6 +239,59 @@ impl Solver {
             }
         };
         self.per_body(bodies, &work);
+    }
+
+    /// With reduced joint trees chosen, takes the step's trees out of the soft step and
+    /// onto their joints (see `articulation.rs`).
+    fn take_trees(
+        &mut self,
+        input: &StepInput<'_, '_>,
+        bodies: &mut SolverBodies,
+        contacts: &[Contact],
+    ) {
+        if input.settings.joint_trees != JointTrees::Reduced {
+            self.trees = articulation::Articulations::default();
+            return;
+        }
+        self.trees.find(&articulation::TreeInput {
+            bodies: input.system.bodies,
+            sims: &bodies.sims,
+            states: &bodies.states,
+            joints: input.joints,
+            links: input.joint_bodies,
+            contacts,
+            ghosts: input.ghosts,
+        });
+        if !self.trees.is_empty() {
+            let world_bodies = input.system.bodies;
+            self.trees
+                .begin(world_bodies, &mut bodies.sims, &mut bodies.states);
+        }
+    }
+
+    /// Hands the trees' bodies back and writes their joints' reactions.
+    fn finish_trees(&mut self, input: &mut StepInput<'_, '_>, bodies: &mut SolverBodies) {
+        let time = input.time;
+        if !self.trees.is_empty() {
+            let (sims, states) = (&mut bodies.sims, &mut bodies.states);
+            let world_bodies = input.system.bodies;
+            self.trees
+                .finish(world_bodies, sims, states, input.joints, time.substeps);
+        }
+    }
+
+    /// The step of a world whose solved bodies are all in joint trees: each substep's
+    /// forces, then the trees' substep.
+    fn step_trees(&mut self, input: &mut StepInput<'_, '_>, bodies: &mut SolverBodies) {
+        let time = input.time;
+        for i in 0..time.substeps {
+            self.evaluate_forces(bodies, input.system, time.t + i as Real * time.h);
+            let forces = (input.system.bodies, &self.wrench[..]);
+            let (sims, states) = (&mut bodies.sims, &mut bodies.states);
+            self.trees.substep(forces, sims, states, time.h);
+        }
+        self.joints.clear();
+        self.finish_trees(input, bodies);
     }
 
     /// Writes back each solved contact's impulses, the rate it was solved at, and whether
@@ -277,6 +344,11 @@ impl Solver {
         self.for_armatures(&mut bodies.states, JointConstraint::begin_armature);
         // After a split kick's second half the forces are those of this substep's start.
         self.kick(bodies, input.system, t, h, (i == 0 || !any_split, false));
+        if !self.trees.is_empty() {
+            let forces = (world_bodies, &self.wrench[..]);
+            self.trees
+                .substep(forces, &mut bodies.sims, &mut bodies.states, h);
+        }
         if self.fine > 1 {
             self.fine_substeps(bodies, input, fine_rule);
         }

@@ -32,6 +32,36 @@ impl SolverKind {
     }
 }
 
+/// How islands that are joint trees are solved (see `solver/articulation.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum JointTrees {
+    /// As every other island: bodies in world coordinates, joints as constraints in the
+    /// soft step (the default).
+    #[default]
+    Maximal,
+    /// In the joints' own coordinates (hinge angles, slider travels) by the
+    /// articulated-body algorithm: exact joints, and a contact-free tree's step at a
+    /// fraction of the cost. Trees only: other islands are solved as with `Maximal`.
+    Reduced,
+}
+
+impl JointTrees {
+    /// The name used in scene files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            JointTrees::Maximal => "maximal",
+            JointTrees::Reduced => "reduced",
+        }
+    }
+
+    /// The choice called `name`.
+    pub fn from_name(name: &str) -> Option<JointTrees> {
+        [JointTrees::Maximal, JointTrees::Reduced]
+            .into_iter()
+            .find(|k| k.name() == name)
+    }
+}
+
 /// Solver settings; `Default` is the soft step with 4 substeps and 1 iteration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverSettings {
@@ -51,6 +81,8 @@ pub struct SolverSettings {
     pub joint_hertz: Real,
     /// Damping ratio of joints' drift correction.
     pub joint_damping_ratio: Real,
+    /// How joint trees are solved.
+    pub joint_trees: JointTrees,
 }
 
 impl Default for SolverSettings {
@@ -64,6 +96,7 @@ impl Default for SolverSettings {
             baumgarte: 0.2,
             joint_hertz: 1000.0,
             joint_damping_ratio: 0.5,
+            joint_trees: JointTrees::Maximal,
         }
     }
 }
@@ -162,6 +195,7 @@ pub(super) fn bias_rule(settings: &SolverSettings, scales: &Scales, time: &StepT
 }
 
 crate::codec::codec_unit_enum!(SolverKind { SoftStep, Pgs });
+crate::codec::codec_unit_enum!(JointTrees { Maximal, Reduced });
 crate::codec::codec_struct!(SolverSettings {
     kind,
     substeps,
@@ -170,7 +204,8 @@ crate::codec::codec_struct!(SolverSettings {
     contact_damping_ratio,
     baumgarte,
     joint_hertz,
-    joint_damping_ratio
+    joint_damping_ratio,
+    joint_trees
 });
 crate::codec::codec_struct!(Scales {
     linear_slop,

@@ -54,7 +54,7 @@ use crate::pipeline::hooks::Hooks;
 use crate::pipeline::sensors::SensorStore;
 
 /// The snapshot format version this build writes and reads.
-pub const SNAPSHOT_VERSION: u32 = 4;
+pub const SNAPSHOT_VERSION: u32 = 5;
 const MAGIC: &[u8; 8] = b"TUMBLESS";
 const HEADER: usize = 8 + 4 + 1 + 4 + 4 + 8 + 8;
 const PRECISION: u8 = std::mem::size_of::<Real>() as u8;
