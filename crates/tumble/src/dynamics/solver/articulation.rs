@@ -83,7 +83,12 @@ struct Link {
     u: Spatial,
     inv_d: Real,
     bias: Real,
+    /// The joint's generalised force (N·m or N) and the coordinate's acceleration.
+    tau: Real,
+    qdd: Real,
     a: Twist,
+    /// The link's velocity when the step began, as given (see `consistent`).
+    given: Twist,
     /// The force the parent applied through the joint, summed over the substeps.
     reaction: Spatial,
 }
@@ -205,7 +210,7 @@ impl Articulations {
         };
         for i in tree.links.clone() {
             let parent = self.links[i].parent.map(|p| self.links[p].body);
-            self.links[i].read_coordinate(input, parent, ground);
+            self.links[i].read_coordinate(input, parent, (ground, tree.origin));
         }
         self.trees.push(tree);
     }
@@ -221,6 +226,12 @@ impl Articulations {
         }
         for t in 0..self.trees.len() {
             self.place(t, bodies, sims, states);
+            if !self.consistent(t) {
+                // A setter (or a step of the soft step) left velocities the joints do
+                // not allow: the rates that keep the momenta instead of the ones read.
+                self.project_rates(t, bodies, sims);
+                self.place(t, bodies, sims, states);
+            }
         }
     }
 
@@ -347,12 +358,23 @@ impl Articulations {
                 torque -= sim.inertia * l.v.w * body.angular_damping;
             }
             l.ia = inertia;
-            l.pa =
-                l.v.cross_force(inertia.apply(l.v))
-                    .sub(Spatial::at(r, force, torque));
+            let gyroscopic = l.v.cross_force(inertia.apply(l.v));
+            l.pa = gyroscopic.sub(Spatial::at(r, force, torque));
             l.c = l.v.cross_motion(l.s.scale(l.qd));
+            l.tau = 0.0;
         }
-        // Leaves to root: each link's inertia and bias as its parent feels them.
+        self.solve(range.clone());
+        for l in &mut self.links[range] {
+            l.qd += h * l.qdd;
+            l.reaction = l.reaction.add(l.ia.apply(l.a).add(l.pa));
+        }
+    }
+
+    /// The articulated-body algorithm's two passes over `range`, each link's rigid
+    /// inertia `ia`, bias force `pa`, velocity-product acceleration `c` and joint force
+    /// `tau` given: leaves to root, the inertia and bias of each subtree as its parent
+    /// feels them through the joint; root to leaves, the accelerations `qdd` and `a`.
+    fn solve(&mut self, range: Range<usize>) {
         for i in range.clone().rev() {
             let l = &mut self.links[i];
             let (ia, pa) = if l.freedom == Freedom::Weld {
@@ -360,7 +382,7 @@ impl Articulations {
             } else {
                 l.u = l.ia.apply(l.s);
                 l.inv_d = 1.0 / (l.s.dot(l.u) + l.armature);
-                l.bias = -l.s.dot(l.pa);
+                l.bias = l.tau - l.s.dot(l.pa);
                 let ia = l.ia.less_outer(l.u, l.inv_d);
                 (ia, l.pa.add(ia.apply(l.c)).add(l.u.scale(l.bias * l.inv_d)))
             };
@@ -369,21 +391,61 @@ impl Articulations {
                 self.links[p].pa = self.links[p].pa.add(pa);
             }
         }
-        // Root to leaves: accelerations.
         for i in range {
             let a_parent = self.links[i]
                 .parent
                 .map_or(Twist::default(), |p| self.links[p].a);
             let l = &mut self.links[i];
             let a = a_parent.add(l.c);
-            l.a = if l.freedom == Freedom::Weld {
-                a
+            (l.qdd, l.a) = if l.freedom == Freedom::Weld {
+                (0.0, a)
             } else {
                 let qdd = (l.bias - a.dot(l.u)) * l.inv_d;
-                l.qd += h * qdd;
-                a.add(l.s.scale(qdd))
+                (qdd, a.add(l.s.scale(qdd)))
             };
-            l.reaction = l.reaction.add(l.ia.apply(l.a).add(l.pa));
+        }
+    }
+
+    /// Whether the bodies of tree `t` moved as its joints allow when the step began:
+    /// each link's velocity from the rates read (`v`, after `place`) is the one it had
+    /// (`given`), to a part in 10⁹ of the tree's speeds.
+    fn consistent(&self, t: usize) -> bool {
+        let links = &self.links[self.trees[t].links.clone()];
+        let size = |m: Twist| m.w.length() + m.v.length();
+        let scale = links.iter().map(|l| size(l.given)).fold(0.0, Real::max);
+        let limit = 1e-9 * (1.0 + scale);
+        links
+            .iter()
+            .all(|l| size(l.v.add(l.given.scale(-1.0))) <= limit)
+    }
+
+    /// The joint rates closest to the velocities the bodies were given, in their kinetic
+    /// energy's metric: q̇ = H⁻¹ Jᵀ M V, what a perfectly inelastic impulse through the
+    /// joints leaves (the generalised momentum of each subtree along its joint is kept).
+    /// Solved as the algorithm's passes with no velocity and the momenta as joint forces.
+    fn project_rates(&mut self, t: usize, bodies: &[Body], sims: &[BodySim]) {
+        let (range, o) = (self.trees[t].links.clone(), self.trees[t].origin);
+        for l in &mut self.links[range.clone()] {
+            let sim = &sims[l.body];
+            l.ia = Inertia::rigid(bodies[l.body].mass, sim.x - o, sim.inertia);
+            // The subtree's momentum, gathered below.
+            l.pa = l.ia.apply(l.given);
+            l.c = Twist::default();
+        }
+        for i in range.clone().rev() {
+            let (momentum, parent) = (self.links[i].pa, self.links[i].parent);
+            let l = &mut self.links[i];
+            l.tau = l.s.dot(momentum) + l.armature * l.qd;
+            if let Some(p) = parent {
+                self.links[p].pa = self.links[p].pa.add(momentum);
+            }
+        }
+        for l in &mut self.links[range.clone()] {
+            l.pa = Spatial::default();
+        }
+        self.solve(range.clone());
+        for l in &mut self.links[range] {
+            l.qd = l.qdd;
         }
     }
 }
@@ -441,19 +503,25 @@ impl Link {
             u: Spatial::default(),
             inv_d: 0.0,
             bias: 0.0,
+            tau: 0.0,
+            qdd: 0.0,
             a: Twist::default(),
+            given: Twist::default(),
             reaction: Spatial::default(),
         }
     }
 
     /// The joint's coordinate and rate at the bodies' state (`parent`: the parent's body,
-    /// `None` for the ground at `ground`).
+    /// `None` for the ground at `ground`), and the link's velocity as given (about `o`).
     fn read_coordinate(
         &mut self,
         input: &TreeInput<'_>,
         parent: Option<usize>,
-        ground: (Vec3, Quat),
+        (ground, o): ((Vec3, Quat), Vec3),
     ) {
+        let state = &input.states[self.body];
+        let r = input.sims[self.body].x - o;
+        self.given = Twist::new(state.w, state.v - state.w.cross(r));
         let motion = |k: Option<usize>| match k {
             Some(k) => {
                 let (x, q) = origin_pose(&input.bodies[k], &input.sims[k]);
