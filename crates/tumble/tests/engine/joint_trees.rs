@@ -594,7 +594,8 @@ fn what_is_not_a_free_tree_is_solved_by_the_soft_step_bit_for_bit() {
         cone: None,
         twist: None,
     };
-    let cases: Vec<(&str, Box<dyn Fn() -> World>)> = vec![
+    type Build = Box<dyn Fn() -> World>;
+    let cases: Vec<(&str, Build)> = vec![
         ("limits", Box::new(pendulum_with(limited))),
         ("motor", Box::new(pendulum_with(motor))),
         ("ball", Box::new(pendulum_with(ball))),
