@@ -868,3 +868,65 @@ fn forces_torques_damping_and_break_forces_act_on_reduced_trees() {
     assert!(w.joint(id).unwrap().is_broken());
     assert!(w.body(rod).unwrap().center_of_mass().y < -1.0);
 }
+
+#[test]
+fn trees_are_found_again_after_every_edit_of_the_joints() {
+    // The trees are kept from step to step while the joints and the bodies' kinds stay
+    // as they were. After each edit, a world stepped on must equal one restored from its
+    // snapshot (which starts with nothing kept): it fails if a kept tree outlives an edit.
+    let (mut w, ids) = every_kind(false);
+    reduced(&mut w, 2);
+    let hashes = |w: &mut World| -> Vec<u64> {
+        (0..5)
+            .map(|_| {
+                w.step(1.0 / 60.0).unwrap();
+                w.state_hash()
+            })
+            .collect()
+    };
+    hashes(&mut w);
+    let joints: Vec<JointId> = w.joints().map(|(id, _)| id).collect();
+    type Edit = Box<dyn Fn(&mut World)>;
+    let (first, second, slide) = (joints[0], joints[1], joints[2]);
+    let edits: Vec<(&str, Edit)> = vec![
+        (
+            "limits",
+            Box::new(move |w| w.set_joint_limits(second, Some([-0.2, 0.2])).unwrap()),
+        ),
+        (
+            "no limits",
+            Box::new(move |w| w.set_joint_limits(second, None).unwrap()),
+        ),
+        (
+            "armature",
+            Box::new(move |w| w.set_joint_armature(first, 0.3).unwrap()),
+        ),
+        (
+            "disabled",
+            Box::new(move |w| w.set_joint_enabled(slide, false).unwrap()),
+        ),
+        (
+            "enabled",
+            Box::new(move |w| w.set_joint_enabled(slide, true).unwrap()),
+        ),
+        (
+            "made again elsewhere",
+            Box::new(move |w| {
+                let mut def = w.joint(second).unwrap().def().clone();
+                w.remove_joint(second).unwrap();
+                def.other_anchor = Vec3::new(0.3, 0.0, 0.0);
+                w.create_joint(&def).unwrap();
+            }),
+        ),
+        (
+            "body removed",
+            Box::new(move |w| w.remove_body(ids[3]).unwrap()),
+        ),
+    ];
+    for (name, edit) in &edits {
+        edit(&mut w);
+        let mut fresh = every_kind(false).0;
+        fresh.restore(&w.snapshot()).unwrap();
+        assert_eq!(hashes(&mut w), hashes(&mut fresh), "after {name}");
+    }
+}

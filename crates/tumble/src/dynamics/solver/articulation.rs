@@ -93,26 +93,91 @@ struct Link {
     reaction: Spatial,
 }
 
-/// A tree: its links (parent before child) and its ground's pose.
+/// A tree: its links (parent before child) and its ground (a static body, or the world)
+/// and that's pose this step.
 #[derive(Debug, Clone)]
 struct Tree {
     links: Range<usize>,
+    ground_body: Option<usize>,
     ground: (Vec3, Quat),
     /// The point spatial vectors are taken about: the ground joint's anchor.
     origin: Vec3,
 }
 
-/// The trees found for a step, and the searches' scratch, kept so that a step allocates
-/// nothing.
+/// The trees the joints make and those a step solves, and the searches' scratch, kept so
+/// that a step allocates nothing.
 #[derive(Default)]
 pub(crate) struct Articulations {
+    /// Every tree of the joints, whether or not a step can solve it (asleep, or in
+    /// contact): found again only when the joints or the bodies' kinds change (`Found`).
     trees: Vec<Tree>,
     links: Vec<Link>,
+    /// The trees this step solves.
+    active: Vec<usize>,
+    found: Found,
     search: Search,
 }
 
-/// Per body: its island's representative (union–find), whether it rules its island out,
-/// and per representative the island's counts; the tree joints as adjacency lists.
+/// What the trees were found from: the bodies' kinds, the joints and their bodies. The
+/// search and the links' frames (a third of a cart-pole's step here) are made again only
+/// when one of these changed.
+#[derive(Default)]
+struct Found {
+    valid: bool,
+    bodies: Vec<(BodyKind, bool)>,
+    joints: Vec<Joint>,
+    links: Vec<[Option<usize>; 2]>,
+}
+
+impl Found {
+    fn unchanged(&self, input: &TreeInput<'_>) -> bool {
+        let kind = |b: &Body| (b.kind, b.planar);
+        self.valid
+            && self.links == input.links
+            && self.bodies.len() == input.bodies.len()
+            && self
+                .bodies
+                .iter()
+                .zip(input.bodies)
+                .all(|(k, b)| *k == kind(b))
+            && self.joints.len() == input.joints.len()
+            && self
+                .joints
+                .iter()
+                .zip(input.joints)
+                .all(|(a, b)| same_joint(a, b))
+    }
+
+    fn keep(&mut self, input: &TreeInput<'_>) {
+        self.valid = true;
+        self.bodies.clear();
+        self.bodies
+            .extend(input.bodies.iter().map(|b| (b.kind, b.planar)));
+        self.links.clear();
+        self.links.extend_from_slice(input.links);
+        self.joints.truncate(input.joints.len());
+        for (i, j) in input.joints.iter().enumerate() {
+            match self.joints.get_mut(i) {
+                Some(kept) => kept.clone_from(j),
+                None => self.joints.push(j.clone()),
+            }
+        }
+    }
+}
+
+/// Whether two joints make the same link: everything `Link::new` and the search read.
+fn same_joint(a: &Joint, b: &Joint) -> bool {
+    let (d, e) = (&a.def, &b.def);
+    a.acts() == b.acts()
+        && (d.kind, d.body, d.other, d.armature) == (e.kind, e.body, e.other, e.armature)
+        && (d.anchor, d.other_anchor) == (e.anchor, e.other_anchor)
+        && (a.axis, a.other_axis, a.reference) == (b.axis, b.other_axis, b.reference)
+        && (a.other_reference, a.relative_rotation) == (b.other_reference, b.relative_rotation)
+}
+
+/// Per body: its island's representative (union–find), whether it rules its island out
+/// (not dynamic, planar, or on a joint the trees do not take), and per representative the
+/// island's counts; the tree joints as adjacency lists.
 #[derive(Default)]
 struct Search {
     root: Vec<u32>,
@@ -123,6 +188,8 @@ struct Search {
     start: Vec<u32>,
     fill: Vec<u32>,
     adjacent: Vec<u32>,
+    /// Per body, in a contact the step solves.
+    touched: Vec<bool>,
 }
 
 /// What the search reads of the world.
@@ -139,12 +206,50 @@ pub(crate) struct TreeInput<'a> {
 impl Articulations {
     /// Whether the step has a tree to solve.
     pub fn is_empty(&self) -> bool {
-        self.trees.is_empty()
+        self.active.is_empty()
     }
 
-    /// Finds the step's trees (see the module header) and sets each link's coordinate
-    /// and rate from the bodies' state.
+    /// Finds the step's trees (see the module header): the joints' trees whose bodies
+    /// all move and touch no contact; sets each one's links' coordinates and rates from
+    /// the bodies' state.
     pub fn find(&mut self, input: &TreeInput<'_>) {
+        self.active.clear();
+        if !self.found.unchanged(input) {
+            self.find_trees(input);
+            self.found.keep(input);
+        }
+        if self.trees.is_empty() {
+            return;
+        }
+        self.search.touch(input);
+        for t in 0..self.trees.len() {
+            let links = &self.links[self.trees[t].links.clone()];
+            let free = |l: &Link| input.sims[l.body].moves && !self.search.touched[l.body];
+            if links.iter().all(free) {
+                self.read(t, input);
+                self.active.push(t);
+            }
+        }
+    }
+
+    /// Tree `t`'s ground pose, and its links' coordinates and rates.
+    fn read(&mut self, t: usize, input: &TreeInput<'_>) {
+        let tree = &mut self.trees[t];
+        let ground = tree.ground_body.map_or((Vec3::ZERO, Quat::IDENTITY), |g| {
+            origin_pose(&input.bodies[g], &input.sims[g])
+        });
+        tree.ground = ground;
+        tree.origin = ground.0 + ground.1 * self.links[tree.links.start].parent_anchor;
+        let (range, origin) = (tree.links.clone(), tree.origin);
+        for i in range {
+            let parent = self.links[i].parent.map(|p| self.links[p].body);
+            self.links[i].read_coordinate(input, parent, (ground, origin));
+        }
+    }
+
+    /// Every tree the joints make (see the module header; whether its bodies move or
+    /// touch a contact is the step's to say).
+    fn find_trees(&mut self, input: &TreeInput<'_>) {
         self.trees.clear();
         self.links.clear();
         if !input.joints.iter().any(|j| j.acts()) {
@@ -171,10 +276,7 @@ impl Articulations {
         let joint = &input.joints[k];
         let child_is_a = input.links[k][0] == Some(body);
         // The joint's other end: `other` (index 1) when the link is its `body`.
-        let ground = input.links[k][child_is_a as usize]
-            .map_or((Vec3::ZERO, Quat::IDENTITY), |g| {
-                origin_pose(&input.bodies[g], &input.sims[g])
-            });
+        let ground_body = input.links[k][child_is_a as usize];
         self.links.push(Link::new(joint, k, body, child_is_a, None));
         let mut next = first;
         while next < self.links.len() {
@@ -202,29 +304,25 @@ impl Articulations {
             }
             next += 1;
         }
-        let origin = ground.0 + ground.1 * self.links[first].parent_anchor;
-        let tree = Tree {
+        self.trees.push(Tree {
             links: first..self.links.len(),
-            ground,
-            origin,
-        };
-        for i in tree.links.clone() {
-            let parent = self.links[i].parent.map(|p| self.links[p].body);
-            self.links[i].read_coordinate(input, parent, (ground, tree.origin));
-        }
-        self.trees.push(tree);
+            ground_body,
+            ground: (Vec3::ZERO, Quat::IDENTITY),
+            origin: Vec3::ZERO,
+        });
     }
 
     /// Takes the trees' bodies from the soft step (it leaves bodies that do not move)
     /// and puts them on their joints at the coordinates read.
     pub fn begin(&mut self, bodies: &[Body], sims: &mut [BodySim], states: &mut [BodyState]) {
-        for l in &self.links {
-            sims[l.body].moves = false;
+        for k in 0..self.active.len() {
+            for l in &mut self.links[self.trees[self.active[k]].links.clone()] {
+                sims[l.body].moves = false;
+                l.reaction = Spatial::default();
+            }
         }
-        for l in &mut self.links {
-            l.reaction = Spatial::default();
-        }
-        for t in 0..self.trees.len() {
+        for k in 0..self.active.len() {
+            let t = self.active[k];
             self.place(t, bodies, sims, states);
             if !self.consistent(t) {
                 // A setter (or a step of the soft step) left velocities the joints do
@@ -243,7 +341,8 @@ impl Articulations {
         states: &mut [BodyState],
         h: Real,
     ) {
-        for t in 0..self.trees.len() {
+        for k in 0..self.active.len() {
+            let t = self.active[k];
             self.accelerate(t, (bodies, wrench), sims, h);
             for l in &mut self.links[self.trees[t].links.clone()] {
                 l.q += h * l.qd;
@@ -572,19 +671,8 @@ impl Search {
         self.root.clear();
         self.root.extend(0..n as u32);
         self.bad.clear();
-        self.bad.extend(
-            input
-                .bodies
-                .iter()
-                .zip(input.sims)
-                .map(|(b, s)| b.kind != BodyKind::Dynamic || !s.moves || b.planar),
-        );
-        for (i, c) in input.contacts.iter().enumerate() {
-            if !c.manifold.is_empty() && !input.ghosts.get(i).copied().unwrap_or(false) {
-                self.bad[c.index_a as usize] = true;
-                self.bad[c.index_b as usize] = true;
-            }
-        }
+        let bad = |b: &Body| b.kind != BodyKind::Dynamic || b.planar;
+        self.bad.extend(input.bodies.iter().map(bad));
         for (k, joint) in input.joints.iter().enumerate() {
             if !joint.acts() {
                 continue;
@@ -601,6 +689,18 @@ impl Search {
             }
         }
         self.count(input);
+    }
+
+    /// Marks the bodies in a contact the step solves.
+    fn touch(&mut self, input: &TreeInput<'_>) {
+        self.touched.clear();
+        self.touched.resize(input.bodies.len(), false);
+        for (i, c) in input.contacts.iter().enumerate() {
+            if !c.manifold.is_empty() && !input.ghosts.get(i).copied().unwrap_or(false) {
+                self.touched[c.index_a as usize] = true;
+                self.touched[c.index_b as usize] = true;
+            }
+        }
     }
 
     fn count(&mut self, input: &TreeInput<'_>) {
