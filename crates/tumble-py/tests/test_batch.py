@@ -64,6 +64,7 @@ def contact_scene():
 SCENES = [
     (contact_scene(), 40),
     (CART_POLE, 50),
+    (dict(CART_POLE, joint_trees="reduced"), 50),
     ("pendulum_chain", 40),
     ("ragdoll", 30),
 ]
@@ -86,7 +87,9 @@ def world_of(scene):
 
 
 @pytest.mark.parametrize("threads", [1, 2])
-@pytest.mark.parametrize("scene,steps", SCENES, ids=["contacts", "cart_pole", "chain", "ragdoll"])
+@pytest.mark.parametrize(
+    "scene,steps", SCENES, ids=["contacts", "cart_pole", "cart_pole_reduced", "chain", "ragdoll"]
+)
 def test_copies_equal_separate_worlds_bit_for_bit(scene, steps, threads):
     w = 3
     batch = tumble.Batch(scene, copies=w, threads=threads)
