@@ -12,9 +12,11 @@ Cases:
   world's bodies kicked by up to 0.05 m/s (before the solver turned its bodies' inertia
   with them, kicks of 0.01 m/s blew some ragdolls up near 0.85 s).
 
-The cart-poles run twice in Tumble: with its default solver (4 substeps a step, what
+The cart-poles run four ways in Tumble: with its default solver (4 substeps a step, what
 every figure of the README uses) and with 1 substep (`"substeps": 1`, closer to MuJoCo's
-one solve per step; the joints are then softer).
+one solve per step; the joints are then softer); and as a joint tree in reduced
+coordinates (`"joint_trees": "reduced"`) at 1 and 4 substeps, which is MuJoCo's own
+Euler scheme (the same trajectory to rounding) at dt and at dt / 4.
 
 MuJoCo runs the same cart-pole as MJCF (the same masses, box sizes, dt and gravity; its
 geoms collide with nothing) through mujoco.rollout.Rollout (a persistent thread pool of
@@ -67,6 +69,10 @@ CART_POLE = {
 }
 
 CART_POLE_1 = dict(CART_POLE, substeps=1)
+# The joints' own coordinates (see `solver/articulation.rs`): MuJoCo's scheme, Euler on the
+# hinge angle and the slider's travel, at 1 and at 4 substeps.
+REDUCED_1 = dict(CART_POLE, substeps=1, joint_trees="reduced")
+REDUCED_4 = dict(CART_POLE, joint_trees="reduced")
 
 CART_POLE_MJCF = """
 <mujoco model="cart_pole">
@@ -185,19 +191,21 @@ def accuracy(theta=1.0, duration=2.0):
 
     truth = mujoco_run(1e-5, mujoco.mjtIntegrator.mjINT_RK4)
     rows = {"MuJoCo Euler": mujoco_run(0.01, mujoco.mjtIntegrator.mjINT_EULER)}
-    for substeps in (1, 4):
-        world = tumble.World.from_json(json.dumps(swinging(theta, substeps)))
+    for substeps, trees in ((1, "maximal"), (4, "maximal"), (1, "reduced"), (4, "reduced")):
+        scene = dict(swinging(theta, substeps), joint_trees=trees)
+        world = tumble.World.from_json(json.dumps(scene))
         out = []
         for _ in range(steps):
             world.step(0.01, 1)
             q = world.orientations[1]
             out.append([world.positions[0][0], 2.0 * np.arctan2(q[1], q[3])])
-        rows[f"Tumble, {substeps} substep{'s' * (substeps > 1)}"] = np.array(out)
+        name = f"Tumble {trees}, {substeps} substep{'s' * (substeps > 1)}"
+        rows[name] = np.array(out)
     print(f"\naccuracy: pole let go {theta} rad from upright, {duration} s at dt = 0.01 s,")
     print("RMS error against MuJoCo RK4 at dt = 1e-5 s")
     for name, run in rows.items():
         err = np.sqrt(np.mean((run - truth) ** 2, axis=0))
-        print(f"  {name:20s} cart {err[0] * 1e3:8.3f} mm   pole {err[1] * 1e3:8.3f} mrad")
+        print(f"  {name:30s} cart {err[0] * 1e3:8.3f} mm   pole {err[1] * 1e3:8.3f} mrad")
 
 
 def main():
@@ -223,6 +231,12 @@ def main():
         rows.append((f"{w} cart-poles, 1 substep; MuJoCo Euler at dt/4", threads, *one, mj4))
         rk4 = mujoco_case(w, n, threads, args.repeat, integrator="RK4")
         rows.append((f"{w} cart-poles; MuJoCo RK4", threads, *four, rk4))
+        # Reduced trees: the same scheme as MuJoCo's Euler, so the same dt is the same
+        # accuracy: at dt (1 substep) and at dt / 4 (4 substeps).
+        r1 = [tumble_case(REDUCED_1, w, n, threads, args.repeat, record=r) for r in (0, 1)]
+        r4 = [tumble_case(REDUCED_4, w, n, threads, args.repeat, record=r) for r in (0, 1)]
+        rows.append((f"{w} cart-poles, reduced, 1 substep", threads, *r1, mj))
+        rows.append((f"{w} cart-poles, reduced, 4 substeps; MuJoCo at dt/4", threads, *r4, mj4))
         w, n = ragdoll
         step = tumble_case("ragdoll", w, n, threads, args.repeat, record=False)
         rec = tumble_case("ragdoll", w, n, threads, args.repeat, record=True)

@@ -31,7 +31,7 @@
 //! the substep). Each joint reports the force it carried, averaged over the substeps.
 
 use super::body::{BodySim, BodyState};
-use super::spatial::{Inertia, Spatial, Twist};
+use super::spatial::{outer, Inertia, Spatial, Twist};
 use crate::collision::contact::Contact;
 use crate::dynamics::body::{Body, BodyKind};
 use crate::dynamics::force::Wrench;
@@ -426,9 +426,14 @@ impl Articulations {
             sim.x = origin + q * body.local_center;
             sim.q = q;
             if !(body.isotropic || body.planar) {
-                // The inverse is made once, in `finish`: the algorithm needs I alone.
-                let r = Mat3::from_quat(q);
-                sim.inertia = r * body.inertia_local * r.transpose();
+                // I = Σ mᵢ aᵢ aᵢᵀ over the principal axes aᵢ in the world: a third of the
+                // products of R I_body Rᵀ. (The inverse is made once, in `finish`: the
+                // algorithm needs I alone.)
+                let axes = Mat3::from_quat(q * body.principal_rotation);
+                let m = body.principal_moments;
+                sim.inertia = outer(axes.x_axis * m.x, axes.x_axis)
+                    + outer(axes.y_axis * m.y, axes.y_axis)
+                    + outer(axes.z_axis * m.z, axes.z_axis);
             }
             state.v = l.v.at(sim.x - o);
             state.w = l.v.w;
@@ -649,9 +654,10 @@ impl Link {
         let joint = &input.joints[self.joint];
         let scalar = |c: JointCoordinate| c.scalar().unwrap_or(0.0);
         (self.q, self.qd) = match self.freedom {
+            // `coords::velocity`'s rate of a hinge, without its anchors.
             Freedom::Hinge => (
                 coords::raw_hinge_angle(joint, a.q, b.q),
-                scalar(coords::velocity(joint, &a, &b)),
+                (a.q * joint.axis).dot(a.w - b.w),
             ),
             Freedom::Slider => (
                 scalar(coords::position(joint, &a, &b)),

@@ -160,7 +160,7 @@ fn skew(r: Vec3) -> Mat3 {
 }
 
 /// a bᵀ.
-fn outer(a: Vec3, b: Vec3) -> Mat3 {
+pub(super) fn outer(a: Vec3, b: Vec3) -> Mat3 {
     Mat3::from_cols(a * b.x, a * b.y, a * b.z)
 }
 
