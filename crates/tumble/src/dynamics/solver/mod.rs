@@ -16,6 +16,10 @@
 //!
 //! This is Box2D v3's soft step (Catto 2024) carried to 3D, with angular momentum as the
 //! integrated rotational state so that constrained bodies tumble as correctly as free ones.
+//!
+//! With `joint_trees` = `Reduced`, the step's contact-free joint trees are taken out first
+//! and advanced in their joints' own coordinates after each substep's kick
+//! (`articulation.rs`); a step with nothing else to solve skips the rest.
 
 mod angular;
 mod articulation;
