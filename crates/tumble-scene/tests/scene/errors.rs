@@ -39,7 +39,7 @@ fn misspelt_keys_are_refused_with_the_allowed_ones() {
         error(r#"{"gravityy": [0, 0, 0]}"#),
         "gravityy: unknown key (expected one of: name, description, gravity, dt, duration, \
          integrator, bodies, forces, joints, solver, substeps, iterations, contact_hertz, \
-         contact_damping_ratio, joint_hertz, joint_damping_ratio, length_unit, sleep, max_speed, \
+         contact_damping_ratio, joint_hertz, joint_damping_ratio, joint_trees, length_unit, sleep, max_speed, \
          max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed, character, state, models, \
          exclude)"
     );
@@ -338,7 +338,7 @@ fn user_text_cannot_break_the_line() {
         error(r#"{"du\nration": 1}"#),
         "du\\nration: unknown key (expected one of: name, description, gravity, dt, duration, \
          integrator, bodies, forces, joints, solver, substeps, iterations, contact_hertz, \
-         contact_damping_ratio, joint_hertz, joint_damping_ratio, length_unit, sleep, max_speed, \
+         contact_damping_ratio, joint_hertz, joint_damping_ratio, joint_trees, length_unit, sleep, max_speed, \
          max_angular_speed, max_contacts, max_contacts_per_body, max_push_speed, character, state, models, \
          exclude)"
     );
