@@ -930,3 +930,55 @@ fn trees_are_found_again_after_every_edit_of_the_joints() {
         assert_eq!(hashes(&mut w), hashes(&mut fresh), "after {name}");
     }
 }
+
+#[test]
+fn a_tree_in_contact_beside_a_free_one_is_the_soft_steps_alone() {
+    // Two rods hinged to the world: one lying on the floor (in contact every step, so
+    // the soft step's), one swinging free above it (the trees'). The resting one must
+    // move exactly as in a world without reduced trees, its joint's reaction and
+    // impulses untouched by the free tree's hand-back.
+    let build = || {
+        let mut w = awake_on_ground(Vec3::new(0.0, -G, 0.0));
+        let half = Vec3::new(0.5, 0.05, 0.05);
+        let lying = block(&mut w, Vec3::new(0.5, 0.05, 0.0), half, 1.0);
+        let left = Vec3::new(-0.5, 0.0, 0.0);
+        join(
+            &mut w,
+            free_hinge(),
+            (lying, left),
+            (None, Vec3::new(0.0, 0.05, 0.0)),
+            Vec3::Z,
+        );
+        let swinging = block(&mut w, Vec3::new(0.5, 3.0, 2.0), half, 1.0);
+        join(
+            &mut w,
+            free_hinge(),
+            (swinging, left),
+            (None, Vec3::new(0.0, 3.0, 2.0)),
+            Vec3::Z,
+        );
+        (w, lying)
+    };
+    let run = |trees: JointTrees| {
+        let (mut w, lying) = build();
+        w.set_solver_settings(SolverSettings {
+            joint_trees: trees,
+            ..w.solver_settings()
+        })
+        .unwrap();
+        (0..60)
+            .map(|_| {
+                w.step(1.0 / 60.0).unwrap();
+                let b = w.body(lying).unwrap();
+                let j = w.joints().next().unwrap().1;
+                (
+                    b.center_of_mass(),
+                    b.orientation(),
+                    j.reaction_force(),
+                    j.reaction_torque(),
+                )
+            })
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(run(JointTrees::Maximal), run(JointTrees::Reduced));
+}

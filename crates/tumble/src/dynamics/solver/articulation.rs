@@ -19,10 +19,13 @@
 //!
 //! Every other island, and a tree in a step where a contact touches it, goes through the
 //! soft step as before: a tree that swings into the floor is solved there for the steps
-//! it touches. Nothing is kept between steps: the coordinates and rates are read from the
-//! bodies' poses and velocities when a step begins (so snapshots, setters and a switch of
-//! solver need nothing), and the poses are then made from them, which also puts bodies
-//! that a setter moved off their joints back on them.
+//! it touches. No state is kept between steps (only the trees' structure, found again
+//! whenever the joints or the bodies' kinds change): the coordinates and rates are read
+//! from the bodies' poses and velocities when a step begins (so snapshots, setters and a
+//! switch of solver need nothing), and the poses are then made from them, which also puts
+//! bodies that a setter moved off their joints back on them. Velocities the joints do not
+//! allow (a kick given to one body) become the rates an inelastic impulse through the
+//! joints would leave (`project_rates`).
 //!
 //! Each substep of h: the forces at the substep's start (the solver's kick evaluates
 //! them for every body), the ABA's q̈ (gyroscopic terms, gravity, applied forces and
@@ -362,7 +365,7 @@ impl Articulations {
         joints: &mut [Joint],
         substeps: u32,
     ) {
-        for t in &self.trees {
+        for t in self.active.iter().map(|&t| &self.trees[t]) {
             for l in &self.links[t.links.clone()] {
                 let (sim, state) = (&mut sims[l.body], &mut states[l.body]);
                 sim.moves = true;
