@@ -79,6 +79,12 @@ pub struct RunArgs {
     #[arg(long, value_name = "NAME")]
     pub solver: Option<String>,
 
+    /// How joint trees are solved; overrides the scene's `joint_trees`: maximal (default,
+    /// the soft step) or reduced (contact-free trees of hinges, sliders and welds in
+    /// their joints' coordinates).
+    #[arg(long, value_name = "WAY")]
+    pub joint_trees: Option<String>,
+
     /// Solver substeps per step; overrides the scene's `substeps`.
     #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = passes)]
     pub substeps: Option<u32>,
@@ -128,6 +134,7 @@ impl Default for RunArgs {
             joints: None,
             sensors: None,
             solver: None,
+            joint_trees: None,
             substeps: None,
             iterations: None,
             threads: None,
@@ -168,11 +175,14 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
     stopped.map_or(Ok(()), Err)
 }
 
-/// `--solver`, `--substeps`, `--iterations` over the scene's settings.
+/// `--solver`, `--joint-trees`, `--substeps`, `--iterations` over the scene's settings.
 fn apply_solver_options(args: &RunArgs, world: &mut World) -> Result<(), Failure> {
     let mut settings = world.solver_settings();
     if let Some(name) = &args.solver {
         settings.kind = tumble_scene::parse_solver(name)?;
+    }
+    if let Some(name) = &args.joint_trees {
+        settings.joint_trees = tumble_scene::parse_joint_trees(name)?;
     }
     settings.substeps = args.substeps.unwrap_or(settings.substeps);
     settings.iterations = args.iterations.unwrap_or(settings.iterations);

@@ -675,3 +675,43 @@ fn the_character_course_walks_its_character() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn joint_trees_choose_the_solver_of_joint_trees() {
+    // A double pendulum of free hinges hung from the world is a tree: reduced, it moves
+    // otherwise than in the soft step (exact joints, another scheme), as the scene key
+    // makes it; an unknown way is refused in one line.
+    let dir = scratch("joint_trees");
+    let scene = |key: &str| {
+        let file = dir.join(format!("pendulum{key}.json"));
+        let text = format!(
+            r#"{{"gravity": [0, -9.81, 0], "dt": 0.01, "sleep": false{key},
+            "bodies": [
+              {{"name": "a", "shape": {{"type": "box", "half_extents": [0.5, 0.05, 0.05]}},
+                "mass": 1.0, "position": [0.5, 0, 0]}},
+              {{"name": "b", "shape": {{"type": "box", "half_extents": [0.5, 0.05, 0.05]}},
+                "mass": 2.0, "position": [1.5, 0, 0]}}],
+            "joints": [
+              {{"type": "hinge", "body": "a", "anchor": [-0.5, 0, 0], "axis": [0, 0, 1]}},
+              {{"type": "hinge", "body": "b", "other": "a", "anchor": [-0.5, 0, 0],
+                "axis": [0, 0, 1]}}]}}"#
+        );
+        std::fs::write(&file, text).unwrap();
+        file
+    };
+    let plain = scene("");
+    let keyed = scene(r#", "joint_trees": "reduced""#);
+    let run = |file: &Path, extra: &[&str]| {
+        let mut args = vec!["run", path(file), "--steps", "60"];
+        args.extend_from_slice(extra);
+        ok(&args)
+    };
+    let (soft, tree) = (run(&plain, &[]), run(&plain, &["--joint-trees", "reduced"]));
+    assert_ne!(soft, tree);
+    assert_eq!(tree, run(&keyed, &[]));
+    assert_eq!(soft, run(&keyed, &["--joint-trees", "maximal"]));
+    assert_eq!(
+        refused(&["run", "--joint-trees", "featherstone"]),
+        "joint_trees: unknown way 'featherstone' (expected one of: maximal, reduced)"
+    );
+}
