@@ -80,8 +80,8 @@ pub struct RunArgs {
     pub solver: Option<String>,
 
     /// How joint trees are solved; overrides the scene's `joint_trees`: maximal (default,
-    /// the soft step) or reduced (contact-free trees of hinges, sliders and welds in
-    /// their joints' coordinates).
+    /// the soft step) or reduced (contact-free trees of hinges, sliders, unlimited ball
+    /// joints and welds in their joints' coordinates).
     #[arg(long, value_name = "WAY")]
     pub joint_trees: Option<String>,
 

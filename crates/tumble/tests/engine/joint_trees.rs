@@ -552,8 +552,8 @@ fn hashes(build: &dyn Fn() -> World, trees: JointTrees, n: usize) -> Vec<u64> {
 
 #[test]
 fn what_is_not_a_free_tree_is_solved_by_the_soft_step_bit_for_bit() {
-    // Limits, motors, springs and servos, ball joints, loops, kinematic parents and
-    // trees resting in contact are the soft step's: choosing reduced trees must not
+    // Limits, motors, springs and servos, ball joints' cones, loops, kinematic parents
+    // and trees resting in contact are the soft step's: choosing reduced trees must not
     // change their motion by a bit.
     let pendulum_with = |kind: JointKind| {
         move || {
@@ -591,14 +591,14 @@ fn what_is_not_a_free_tree_is_solved_by_the_soft_step_bit_for_bit() {
         servo: None,
     };
     let ball = JointKind::Ball {
-        cone: None,
+        cone: Some(0.5),
         twist: None,
     };
     type Build = Box<dyn Fn() -> World>;
     let cases: Vec<(&str, Build)> = vec![
         ("limits", Box::new(pendulum_with(limited))),
         ("motor", Box::new(pendulum_with(motor))),
-        ("ball", Box::new(pendulum_with(ball))),
+        ("ball with a cone", Box::new(pendulum_with(ball))),
         (
             "loop",
             Box::new(|| {
@@ -981,4 +981,94 @@ fn a_tree_in_contact_beside_a_free_one_is_the_soft_steps_alone() {
             .collect::<Vec<_>>()
     };
     assert_eq!(run(JointTrees::Maximal), run(JointTrees::Reduced));
+}
+
+/// A chain of `links` boxes on ball joints hung from the world, bent out of plane and
+/// spun, so that every joint turns about all three axes. `flip` defines the joints
+/// between links with the parent as `body`.
+fn ball_chain(links: usize, flip: bool) -> (World, Vec<BodyId>) {
+    let mut w = awake(Vec3::new(0.0, -G, 0.0));
+    let ball = JointKind::Ball {
+        cone: None,
+        twist: None,
+    };
+    let half = Vec3::new(0.05, 0.25, 0.08);
+    let mut ids: Vec<BodyId> = Vec::new();
+    for i in 0..links {
+        let y = -0.5 * i as Real - 0.25;
+        let id = block(
+            &mut w,
+            Vec3::new(0.1 * i as Real, y, 0.0),
+            half,
+            1.0 + i as Real,
+        );
+        let top = Vec3::new(0.0, 0.25, 0.0);
+        match ids.last() {
+            None => {
+                join(&mut w, ball, (id, top), (None, Vec3::ZERO), Vec3::X);
+            }
+            Some(&p) => {
+                let at = w.body(id).unwrap().pose().transform_point(top);
+                let on_parent = w.body(p).unwrap().pose().inverse_transform_point(at);
+                if flip {
+                    join(&mut w, ball, (p, on_parent), (Some(id), top), Vec3::X);
+                } else {
+                    join(&mut w, ball, (id, top), (Some(p), on_parent), Vec3::X);
+                }
+            }
+        }
+        w.set_angular_velocity(id, Vec3::new(0.5, 1.0 - i as Real, 0.3 * i as Real))
+            .unwrap();
+        ids.push(id);
+    }
+    (w, ids)
+}
+
+#[test]
+fn ball_joints_turn_freely_and_exactly_either_way_round() {
+    // Ball joints (without a cone or twist) are three freedoms of a tree: the chain keeps
+    // its anchors together to rounding, moves the same whichever body each joint names
+    // first, agrees with the soft step at fine substeps, and keeps its energy.
+    let run = |flip: bool, trees: JointTrees, substeps: u32| {
+        let (mut w, ids) = ball_chain(4, flip);
+        w.set_solver_settings(SolverSettings {
+            joint_trees: trees,
+            substeps,
+            ..w.solver_settings()
+        })
+        .unwrap();
+        let energy = |w: &World| {
+            w.bodies()
+                .map(|(_, b)| b.kinetic_energy() + b.mass() * G * b.center_of_mass().y)
+                .sum::<Real>()
+        };
+        let (e0, mut worst) = (energy(&w), 0.0 as Real);
+        for _ in 0..30 {
+            w.step(1.0 / 60.0).unwrap();
+            worst = worst.max((energy(&w) - e0).abs());
+        }
+        let at: Vec<Vec3> = ids
+            .iter()
+            .map(|&id| w.body(id).unwrap().center_of_mass())
+            .collect();
+        (at, max_joint_gap(&w), worst)
+    };
+    let (one, gap, _) = run(false, JointTrees::Reduced, 4);
+    let (other, gap_flipped, _) = run(true, JointTrees::Reduced, 4);
+    assert!(
+        gap.max(gap_flipped) < tol(1e-9, 1e-4),
+        "gaps {gap}, {gap_flipped}"
+    );
+    for (a, b) in one.iter().zip(&other) {
+        assert!((*a - *b).length() < tol(1e-9, 1e-3), "{a:?} vs {b:?}");
+    }
+    let (soft, _, _) = run(false, JointTrees::Maximal, 16);
+    let (tree, _, worst) = run(false, JointTrees::Reduced, 16);
+    for (a, b) in soft.iter().zip(&tree) {
+        assert!((*a - *b).length() < 0.01, "soft {a:?}, reduced {b:?}");
+    }
+    // It moved, about more than one axis.
+    assert!(tree[3].z.abs() > 0.005, "{:?}", tree[3]);
+    let scale = G * 10.0 * 1.0;
+    assert!(worst < 0.01 * scale, "energy moved {worst} J of {scale} J");
 }

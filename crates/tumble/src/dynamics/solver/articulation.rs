@@ -12,8 +12,8 @@
 //! What is solved so: each island (bodies joined by acting joints) that
 //! - hangs from the ground (the world or a static body) by exactly one joint,
 //! - is a tree (one joint fewer than bodies),
-//! - has only hinges, sliders and fixed joints without limits, motor, spring or servo
-//!   (armatures and break forces are kept),
+//! - has only hinges and sliders without limits, motor, spring or servo (armatures and
+//!   break forces are kept), ball joints without cone or twist limits, and fixed joints,
 //! - has awake, dynamic, non-planar bodies, none in a contact the step solves and none
 //!   joined to a kinematic body.
 //!
@@ -48,7 +48,26 @@ use std::ops::Range;
 enum Freedom {
     Hinge,
     Slider,
+    /// Three: a ball joint without limits (see [`Ball`]).
+    Ball,
     Weld,
+}
+
+/// A ball joint's coordinates and the algorithm's quantities for its three freedoms: the
+/// link's orientation relative to its parent (`rel`, q_link = q_parent · rel) and its
+/// angular velocity relative to the parent in its own frame (`w`: MuJoCo's ball qvel,
+/// integrated as MuJoCo does, rel ← rel · exp(h w)). The motion subspace's columns are
+/// rotations about the link's own axes through the anchor.
+#[derive(Debug, Clone, Copy, Default)]
+struct Ball {
+    rel: Quat,
+    w: Vec3,
+    s: [Twist; 3],
+    u: [Spatial; 3],
+    inv_d: Mat3,
+    bias: Vec3,
+    tau: Vec3,
+    wdd: Vec3,
 }
 
 /// A body of a tree with the joint to its parent: the joint's frames as seen from the
@@ -74,9 +93,12 @@ struct Link {
     armature: Real,
     q: Real,
     qd: Real,
-    /// The joint's motion subspace and the link's velocity (spatial).
+    /// The joint's motion subspace (one freedom), the joint's own motion S q̇ and the
+    /// link's velocity (spatial).
     s: Twist,
+    vj: Twist,
     v: Twist,
+    ball: Ball,
     /// Where the joint's `other` anchor is, for the reaction's torque.
     other_anchor: Vec3,
     // The algorithm's quantities (see `Articulations::accelerate`).
@@ -349,6 +371,9 @@ impl Articulations {
             self.accelerate(t, (bodies, wrench), sims, h);
             for l in &mut self.links[self.trees[t].links.clone()] {
                 l.q += h * l.qd;
+                if l.freedom == Freedom::Ball {
+                    l.ball.rel = (l.ball.rel * Quat::from_scaled_axis(l.ball.w * h)).normalize();
+                }
                 states[l.body].turned += l.v.w * h;
             }
             self.place(t, bodies, sims, states);
@@ -400,29 +425,8 @@ impl Articulations {
                 None => (tree.ground.0, tree.ground.1, Twist::default()),
             };
             let l = &mut self.links[i];
-            let turn = match l.freedom {
-                Freedom::Hinge => Quat::from_axis_angle(l.axis, l.sigma * l.q),
-                _ => Quat::IDENTITY,
-            };
-            let q = (qp * turn * l.offset).normalize();
-            // The same turn as ±q: the sign the body had, so that its quaternion moves
-            // continuously (a reader of [x, y, z, w] sees no jump).
-            let q = if q.dot(sims[l.body].q) < 0.0 { -q } else { q };
-            let p = xp + qp * l.parent_anchor;
-            let (anchor, s) = match l.freedom {
-                Freedom::Hinge => {
-                    let n = qp * l.axis * l.sigma;
-                    (p, Twist::new(n, (p - o).cross(n)))
-                }
-                Freedom::Slider => {
-                    let h = qp * l.axis * l.sigma;
-                    (p + h * l.q, Twist::new(Vec3::ZERO, h))
-                }
-                Freedom::Weld => (p, Twist::default()),
-            };
-            l.other_anchor = if l.sigma < 0.0 { anchor } else { p };
-            l.s = s;
-            l.v = vp.add(s.scale(l.qd));
+            let (q, anchor) = l.pose((xp, qp), o, sims[l.body].q);
+            l.v = vp.add(l.vj);
             let body = &bodies[l.body];
             let (sim, state) = (&mut sims[l.body], &mut states[l.body]);
             let origin = anchor - q * l.child_anchor;
@@ -467,12 +471,14 @@ impl Articulations {
             l.ia = inertia;
             let gyroscopic = l.v.cross_force(inertia.apply(l.v));
             l.pa = gyroscopic.sub(Spatial::at(r, force, torque));
-            l.c = l.v.cross_motion(l.s.scale(l.qd));
+            l.c = l.v.cross_motion(l.vj);
             l.tau = 0.0;
+            l.ball.tau = Vec3::ZERO;
         }
         self.solve(range.clone());
         for l in &mut self.links[range] {
             l.qd += h * l.qdd;
+            l.ball.w += h * l.ball.wdd;
             l.reaction = l.reaction.add(l.ia.apply(l.a).add(l.pa));
         }
     }
@@ -484,14 +490,16 @@ impl Articulations {
     fn solve(&mut self, range: Range<usize>) {
         for i in range.clone().rev() {
             let l = &mut self.links[i];
-            let (ia, pa) = if l.freedom == Freedom::Weld {
-                (l.ia, l.pa.add(l.ia.apply(l.c)))
-            } else {
-                l.u = l.ia.apply(l.s);
-                l.inv_d = 1.0 / (l.s.dot(l.u) + l.armature);
-                l.bias = l.tau - l.s.dot(l.pa);
-                let ia = l.ia.less_outer(l.u, l.inv_d);
-                (ia, l.pa.add(ia.apply(l.c)).add(l.u.scale(l.bias * l.inv_d)))
+            let (ia, pa) = match l.freedom {
+                Freedom::Weld => (l.ia, l.pa.add(l.ia.apply(l.c))),
+                Freedom::Ball => l.ball.articulate(&l.ia, l.pa, l.c),
+                _ => {
+                    l.u = l.ia.apply(l.s);
+                    l.inv_d = 1.0 / (l.s.dot(l.u) + l.armature);
+                    l.bias = l.tau - l.s.dot(l.pa);
+                    let ia = l.ia.less_outer(l.u, l.inv_d);
+                    (ia, l.pa.add(ia.apply(l.c)).add(l.u.scale(l.bias * l.inv_d)))
+                }
             };
             if let Some(p) = l.parent {
                 self.links[p].ia.add(&ia);
@@ -504,11 +512,13 @@ impl Articulations {
                 .map_or(Twist::default(), |p| self.links[p].a);
             let l = &mut self.links[i];
             let a = a_parent.add(l.c);
-            (l.qdd, l.a) = if l.freedom == Freedom::Weld {
-                (0.0, a)
-            } else {
-                let qdd = (l.bias - a.dot(l.u)) * l.inv_d;
-                (qdd, a.add(l.s.scale(qdd)))
+            (l.qdd, l.a) = match l.freedom {
+                Freedom::Weld => (0.0, a),
+                Freedom::Ball => (0.0, l.ball.accelerate(a)),
+                _ => {
+                    let qdd = (l.bias - a.dot(l.u)) * l.inv_d;
+                    (qdd, a.add(l.s.scale(qdd)))
+                }
             };
         }
     }
@@ -543,6 +553,8 @@ impl Articulations {
             let (momentum, parent) = (self.links[i].pa, self.links[i].parent);
             let l = &mut self.links[i];
             l.tau = l.s.dot(momentum) + l.armature * l.qd;
+            let [s0, s1, s2] = l.ball.s;
+            l.ball.tau = Vec3::new(s0.dot(momentum), s1.dot(momentum), s2.dot(momentum));
             if let Some(p) = parent {
                 self.links[p].pa = self.links[p].pa.add(momentum);
             }
@@ -553,7 +565,44 @@ impl Articulations {
         self.solve(range.clone());
         for l in &mut self.links[range] {
             l.qd = l.qdd;
+            l.ball.w = l.ball.wdd;
         }
+    }
+}
+
+impl Ball {
+    /// The backward pass's step for three freedoms: U = I_A S, D = Sᵀ U, u = τ − Sᵀ p_A;
+    /// returns I_A − U D⁻¹ Uᵀ and p_A + I_a c + U D⁻¹ u, what the parent feels.
+    fn articulate(&mut self, ia: &Inertia, pa: Spatial, c: Twist) -> (Inertia, Spatial) {
+        let s = self.s;
+        self.u = s.map(|s| ia.apply(s));
+        let column = |u: Spatial| Vec3::new(s[0].dot(u), s[1].dot(u), s[2].dot(u));
+        let d = Mat3::from_cols(column(self.u[0]), column(self.u[1]), column(self.u[2]));
+        self.inv_d = d.inverse();
+        self.bias = self.tau - Vec3::new(s[0].dot(pa), s[1].dot(pa), s[2].dot(pa));
+        // U D⁻¹: three force vectors, each a mix of the u's.
+        let u = self.u;
+        let mix = |m: Vec3| u[0].scale(m.x).add(u[1].scale(m.y)).add(u[2].scale(m.z));
+        let w = [0, 1, 2].map(|j| mix(self.inv_d.row(j)));
+        let mut articulated = *ia;
+        for j in 0..3 {
+            articulated = articulated.less(w[j], u[j]);
+        }
+        let pa = pa
+            .add(articulated.apply(c))
+            .add(mix(self.inv_d * self.bias));
+        (articulated, pa)
+    }
+
+    /// The forward pass's step: ẇ = D⁻¹ (u − Uᵀ a′); returns a′ + S ẇ.
+    fn accelerate(&mut self, a: Twist) -> Twist {
+        let u = self.u;
+        let ua = Vec3::new(a.dot(u[0]), a.dot(u[1]), a.dot(u[2]));
+        self.wdd = self.inv_d * (self.bias - ua);
+        let [s0, s1, s2] = self.s;
+        a.add(s0.scale(self.wdd.x))
+            .add(s1.scale(self.wdd.y))
+            .add(s2.scale(self.wdd.z))
     }
 }
 
@@ -564,6 +613,7 @@ impl Link {
         let (freedom, rel) = match def.kind {
             JointKind::Hinge { .. } => (Freedom::Hinge, joint.relative_rotation),
             JointKind::Slider { .. } => (Freedom::Slider, joint.relative_rotation),
+            JointKind::Ball { .. } => (Freedom::Ball, joint.relative_rotation),
             _ => (Freedom::Weld, joint.relative_rotation),
         };
         // Frames that coincide when the hinge's angle is zero: axis, reference, their
@@ -602,7 +652,9 @@ impl Link {
             q: 0.0,
             qd: 0.0,
             s: Twist::default(),
+            vj: Twist::default(),
             v: Twist::default(),
+            ball: Ball::default(),
             other_anchor: Vec3::ZERO,
             ia: Inertia::default(),
             pa: Spatial::default(),
@@ -616,6 +668,54 @@ impl Link {
             given: Twist::default(),
             reaction: Spatial::default(),
         }
+    }
+
+    /// The link's orientation and anchor from its parent's pose (`xp` the origin, `qp`)
+    /// and the joint's coordinates; sets the motion subspace, the joint's motion S q̇ and
+    /// where the joint's `other` anchor is. `was`: the link's orientation before.
+    fn pose(&mut self, (xp, qp): (Vec3, Quat), o: Vec3, was: Quat) -> (Quat, Vec3) {
+        let q = match self.freedom {
+            Freedom::Hinge => {
+                qp * Quat::from_axis_angle(self.axis, self.sigma * self.q) * self.offset
+            }
+            Freedom::Ball => qp * self.ball.rel,
+            _ => qp * self.offset,
+        }
+        .normalize();
+        // The same turn as ±q: the sign the body had, so that its quaternion moves
+        // continuously (a reader of [x, y, z, w] sees no jump).
+        let q = if q.dot(was) < 0.0 { -q } else { q };
+        let p = xp + qp * self.parent_anchor;
+        let arm = p - o;
+        let anchor = match self.freedom {
+            Freedom::Hinge => {
+                let n = qp * self.axis * self.sigma;
+                self.s = Twist::new(n, arm.cross(n));
+                p
+            }
+            Freedom::Slider => {
+                let h = qp * self.axis * self.sigma;
+                self.s = Twist::new(Vec3::ZERO, h);
+                p + h * self.q
+            }
+            Freedom::Ball => {
+                let r = Mat3::from_quat(q);
+                let column = |a: Vec3| Twist::new(a, arm.cross(a));
+                self.ball.s = [column(r.x_axis), column(r.y_axis), column(r.z_axis)];
+                let w = q * self.ball.w;
+                self.vj = Twist::new(w, arm.cross(w));
+                p
+            }
+            Freedom::Weld => {
+                self.s = Twist::default();
+                p
+            }
+        };
+        if self.freedom != Freedom::Ball {
+            self.vj = self.s.scale(self.qd);
+        }
+        self.other_anchor = if self.sigma < 0.0 { anchor } else { p };
+        (q, anchor)
     }
 
     /// The joint's coordinate and rate at the bodies' state (`parent`: the parent's body,
@@ -649,6 +749,11 @@ impl Link {
             },
         };
         let (child, parent) = (motion(Some(self.body)), motion(parent));
+        if self.freedom == Freedom::Ball {
+            self.ball.rel = (parent.q.inverse() * child.q).normalize();
+            self.ball.w = child.q.inverse() * (child.w - parent.w);
+            return;
+        }
         let (a, b) = if self.sigma > 0.0 {
             (child, parent)
         } else {
@@ -666,7 +771,7 @@ impl Link {
                 scalar(coords::position(joint, &a, &b)),
                 scalar(coords::velocity(joint, &a, &b)),
             ),
-            Freedom::Weld => (0.0, 0.0),
+            Freedom::Weld | Freedom::Ball => (0.0, 0.0),
         };
     }
 }
@@ -800,8 +905,9 @@ fn supported(joint: &Joint) -> bool {
             spring,
             servo,
         } => limits.is_none() && motor.is_none() && spring.is_none() && servo.is_none(),
+        JointKind::Ball { cone, twist } => cone.is_none() && twist.is_none(),
         JointKind::Fixed => true,
-        _ => false,
+        JointKind::Distance { .. } => false,
     }
 }
 

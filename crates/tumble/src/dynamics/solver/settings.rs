@@ -39,7 +39,8 @@ pub enum JointTrees {
     /// soft step (the default).
     #[default]
     Maximal,
-    /// In the joints' own coordinates (hinge angles, slider travels) by the
+    /// In the joints' own coordinates (hinge angles, slider travels, ball joints'
+    /// relative orientations) by the
     /// articulated-body algorithm: exact joints, and a contact-free tree's step at a
     /// fraction of the cost. Trees only: other islands are solved as with `Maximal`.
     Reduced,

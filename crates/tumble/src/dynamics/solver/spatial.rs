@@ -140,6 +140,16 @@ impl Inertia {
         self.c += o.c;
     }
 
+    /// self − a bᵀ, for a sum of such terms that is symmetric (U D⁻¹ Uᵀ over a joint's
+    /// freedoms): the lower left block is taken as the upper right's transpose.
+    pub fn less(&self, a: Spatial, b: Spatial) -> Inertia {
+        Inertia {
+            a: self.a - outer(a.n, b.n),
+            b: self.b - outer(a.n, b.f),
+            c: self.c - outer(a.f, b.f),
+        }
+    }
+
     /// self − u uᵀ / d: what a joint's freedom passes on of the inertia beyond it.
     pub fn less_outer(&self, u: Spatial, inv_d: Real) -> Inertia {
         Inertia {
