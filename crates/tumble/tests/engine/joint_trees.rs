@@ -10,14 +10,26 @@ use tumble::prelude::*;
 
 const G: Real = 9.81;
 
-/// `w` with its joint trees solved in reduced coordinates, at `substeps` a step.
-fn reduced(w: &mut World, substeps: u32) {
+/// `w` with its joint trees solved as `trees` says, at `substeps` a step.
+fn solve_trees(w: &mut World, trees: JointTrees, substeps: u32) {
     w.set_solver_settings(SolverSettings {
-        joint_trees: JointTrees::Reduced,
+        joint_trees: trees,
         substeps,
         ..w.solver_settings()
     })
     .unwrap();
+}
+
+/// `w` with its joint trees solved in reduced coordinates, at `substeps` a step.
+fn reduced(w: &mut World, substeps: u32) {
+    solve_trees(w, JointTrees::Reduced, substeps);
+}
+
+/// Kinetic plus potential energy of every body, gravity G along −y (J).
+fn energy(w: &World) -> Real {
+    w.bodies()
+        .map(|(_, b)| b.kinetic_energy() + b.mass() * G * b.center_of_mass().y)
+        .sum()
 }
 
 /// A box of `half` extents and `mass` at `position`.
@@ -103,15 +115,6 @@ fn rod_pendulum(length: Real, angle: Real) -> (World, BodyId) {
 fn rod_angle(w: &World, rod: BodyId) -> Real {
     let c = w.body(rod).unwrap().center_of_mass();
     c.x.atan2(-c.y)
-}
-
-/// Complete elliptic integral of the first kind K(k), by the arithmetic–geometric mean.
-fn elliptic_k(k: f64) -> f64 {
-    let (mut a, mut b) = (1.0f64, (1.0 - k * k).sqrt());
-    for _ in 0..30 {
-        (a, b) = (0.5 * (a + b), (a * b).sqrt());
-    }
-    std::f64::consts::PI / (2.0 * a)
 }
 
 #[test]
@@ -260,11 +263,6 @@ fn a_reduced_double_pendulum_keeps_its_energy_and_converges_at_first_order() {
         );
         (w, second)
     };
-    let energy = |w: &World| {
-        w.bodies()
-            .map(|(_, b)| b.kinetic_energy() + b.mass() * G * b.center_of_mass().y)
-            .sum::<Real>()
-    };
     let (mut w, _) = build();
     reduced(&mut w, 16);
     let e0 = energy(&w);
@@ -331,12 +329,7 @@ fn the_reduced_and_soft_solvers_agree_as_the_step_shrinks() {
             (Some(cart), Vec3::ZERO),
             Vec3::Y,
         );
-        w.set_solver_settings(SolverSettings {
-            joint_trees: trees,
-            substeps,
-            ..w.solver_settings()
-        })
-        .unwrap();
+        solve_trees(&mut w, trees, substeps);
         for _ in 0..240 {
             w.step(1.0 / 240.0).unwrap();
         }
@@ -431,17 +424,7 @@ fn a_tree_of_every_kind_matches_the_soft_step_and_keeps_its_energy() {
     // and the reduced one's energy within 1 % of the swing's scale.
     let run = |trees: JointTrees| {
         let (mut w, ids) = every_kind(false);
-        w.set_solver_settings(SolverSettings {
-            joint_trees: trees,
-            substeps: 16,
-            ..w.solver_settings()
-        })
-        .unwrap();
-        let energy = |w: &World| {
-            w.bodies()
-                .map(|(_, b)| b.kinetic_energy() + b.mass() * G * b.center_of_mass().y)
-                .sum::<Real>()
-        };
+        solve_trees(&mut w, trees, 16);
         let (e0, mut worst) = (energy(&w), 0.0 as Real);
         for _ in 0..30 {
             w.step(1.0 / 60.0).unwrap();
@@ -500,12 +483,7 @@ fn reaction_forces_are_the_soft_steps() {
     // within 1 % of the weight; hanging still, exactly the weight.
     let run = |trees: JointTrees, angle: Real| {
         let (mut w, _) = rod_pendulum(1.0, angle);
-        w.set_solver_settings(SolverSettings {
-            joint_trees: trees,
-            substeps: 16,
-            ..w.solver_settings()
-        })
-        .unwrap();
+        solve_trees(&mut w, trees, 16);
         (0..30)
             .map(|_| {
                 w.step(1.0 / 60.0).unwrap();
@@ -537,11 +515,8 @@ fn reaction_forces_are_the_soft_steps() {
 /// State hashes of `n` steps of 1/60 s of the world `build` makes, under `trees`.
 fn hashes(build: &dyn Fn() -> World, trees: JointTrees, n: usize) -> Vec<u64> {
     let mut w = build();
-    w.set_solver_settings(SolverSettings {
-        joint_trees: trees,
-        ..w.solver_settings()
-    })
-    .unwrap();
+    let substeps = w.solver_settings().substeps;
+    solve_trees(&mut w, trees, substeps);
     (0..n)
         .map(|_| {
             w.step(1.0 / 60.0).unwrap();
@@ -961,11 +936,8 @@ fn a_tree_in_contact_beside_a_free_one_is_the_soft_steps_alone() {
     };
     let run = |trees: JointTrees| {
         let (mut w, lying) = build();
-        w.set_solver_settings(SolverSettings {
-            joint_trees: trees,
-            ..w.solver_settings()
-        })
-        .unwrap();
+        let substeps = w.solver_settings().substeps;
+        solve_trees(&mut w, trees, substeps);
         (0..60)
             .map(|_| {
                 w.step(1.0 / 60.0).unwrap();
@@ -1031,17 +1003,7 @@ fn ball_joints_turn_freely_and_exactly_either_way_round() {
     // first, agrees with the soft step at fine substeps, and keeps its energy.
     let run = |flip: bool, trees: JointTrees, substeps: u32| {
         let (mut w, ids) = ball_chain(4, flip);
-        w.set_solver_settings(SolverSettings {
-            joint_trees: trees,
-            substeps,
-            ..w.solver_settings()
-        })
-        .unwrap();
-        let energy = |w: &World| {
-            w.bodies()
-                .map(|(_, b)| b.kinetic_energy() + b.mass() * G * b.center_of_mass().y)
-                .sum::<Real>()
-        };
+        solve_trees(&mut w, trees, substeps);
         let (e0, mut worst) = (energy(&w), 0.0 as Real);
         for _ in 0..30 {
             w.step(1.0 / 60.0).unwrap();

@@ -9,17 +9,6 @@ use tumble::prelude::*;
 
 const G: Real = 9.8;
 
-/// Complete elliptic integral of the first kind K(k), by the arithmetic–geometric mean.
-fn elliptic_k(k: f64) -> f64 {
-    let (mut a, mut b) = (1.0f64, (1.0 - k * k).sqrt());
-    for _ in 0..30 {
-        let (an, bn) = (0.5 * (a + b), (a * b).sqrt());
-        a = an;
-        b = bn;
-    }
-    std::f64::consts::PI / (2.0 * a)
-}
-
 /// A ball of radius r on a massless hinge at the origin (axis z), released at `angle`
 /// from the downward vertical. Returns the world, the ball, its mass, and the moment of
 /// inertia about the pivot.

@@ -87,3 +87,13 @@ pub fn run(world: &mut World, dt: Real, n: usize) {
         world.step(dt).unwrap();
     }
 }
+
+/// Complete elliptic integral of the first kind K(k), by the arithmetic–geometric mean
+/// (a pendulum's period at amplitude θ₀ is the small-swing one times 2K(sin(θ₀/2))/π).
+pub fn elliptic_k(k: f64) -> f64 {
+    let (mut a, mut b) = (1.0f64, (1.0 - k * k).sqrt());
+    for _ in 0..30 {
+        (a, b) = (0.5 * (a + b), (a * b).sqrt());
+    }
+    std::f64::consts::PI / (2.0 * a)
+}
