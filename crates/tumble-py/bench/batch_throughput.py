@@ -21,10 +21,12 @@ Euler scheme (the same trajectory to rounding) at dt and at dt / 4.
 MuJoCo runs the same cart-pole as MJCF (the same masses, box sizes, dt and gravity; its
 geoms collide with nothing) through mujoco.rollout.Rollout (a persistent thread pool of
 `nthread` threads; nthread = 0 steps on the calling thread) with zero control.
-rollout writes every step's state into its output array, so Tumble is timed both ways:
-`step` (nothing recorded) and `simulate(every=1)` (every step's positions, orientations,
-velocities and angular velocities recorded). The figures are the best of `--repeat`
-runs (default 3), as world-steps per second = W × steps / seconds.
+rollout writes every step's state into the output array it is given (allocated once,
+outside the timing), so Tumble is timed three ways: `step` (nothing recorded),
+`simulate(every=1)` (every step's positions, orientations, velocities and angular
+velocities recorded into new arrays) and `simulate(every=1, out=...)` (recorded into the
+arrays of an earlier run, as rollout does). The figures are the best of `--repeat` runs
+(default 3), as world-steps per second = W × steps / seconds.
 
 Same dt is not same accuracy, so the script also measures each run's error on a pole let
 go 1 rad from upright (`accuracy`: RMS error over 2 s against MuJoCo's RK4 at 1e-5 s) and
@@ -105,15 +107,30 @@ def best(fn, repeat):
 
 
 def tumble_case(scene, copies, steps, threads, repeat, record, kick=0.05):
-    def setup():
-        batch = tumble.Batch(scene, copies=copies, threads=threads)
+    """World-steps per second of Tumble's batch: `record` None (`step`), "new"
+    (`simulate` into new arrays) or "out" (`simulate` into an earlier run's arrays)."""
+
+    def batch():
+        b = tumble.Batch(scene, copies=copies, threads=threads)
         if kick:
-            batch.randomize(np.random.default_rng(1), velocities=kick)
-        if record:
-            return lambda: batch.simulate(steps=steps, every=1)
-        return lambda: batch.step(steps=steps)
+            b.randomize(np.random.default_rng(1), velocities=kick)
+        return b
+
+    def setup():
+        b = batch()
+        if record == "out":
+            out = batch().simulate(steps=steps, every=1)
+            return lambda: b.simulate(steps=steps, every=1, out=out)
+        if record == "new":
+            return lambda: b.simulate(steps=steps, every=1)
+        return lambda: b.step(steps=steps)
 
     return copies * steps / best(setup, repeat)
+
+
+def tumble_cases(scene, copies, steps, threads, repeat):
+    """`tumble_case` for each way of recording: step, simulate, simulate into out."""
+    return [tumble_case(scene, copies, steps, threads, repeat, r) for r in (None, "new", "out")]
 
 
 def mujoco_case(copies, steps, threads, repeat, integrator="EULER", split=1):
@@ -220,8 +237,8 @@ def main():
     rows = []
     for threads in (1, 2):
         w, n = cart
-        four = [tumble_case(CART_POLE, w, n, threads, args.repeat, record=r) for r in (0, 1)]
-        one = [tumble_case(CART_POLE_1, w, n, threads, args.repeat, record=r) for r in (0, 1)]
+        four = tumble_cases(CART_POLE, w, n, threads, args.repeat)
+        one = tumble_cases(CART_POLE_1, w, n, threads, args.repeat)
         mj = mujoco_case(w, n, threads, args.repeat)
         rows.append((f"{w} cart-poles", threads, *four, mj))
         rows.append((f"{w} cart-poles, 1 substep", threads, *one, mj))
@@ -233,22 +250,23 @@ def main():
         rows.append((f"{w} cart-poles; MuJoCo RK4", threads, *four, rk4))
         # Reduced trees: the same scheme as MuJoCo's Euler, so the same dt is the same
         # accuracy: at dt (1 substep) and at dt / 4 (4 substeps).
-        r1 = [tumble_case(REDUCED_1, w, n, threads, args.repeat, record=r) for r in (0, 1)]
-        r4 = [tumble_case(REDUCED_4, w, n, threads, args.repeat, record=r) for r in (0, 1)]
+        r1 = tumble_cases(REDUCED_1, w, n, threads, args.repeat)
+        r4 = tumble_cases(REDUCED_4, w, n, threads, args.repeat)
         rows.append((f"{w} cart-poles, reduced, 1 substep", threads, *r1, mj))
         rows.append((f"{w} cart-poles, reduced, 4 substeps; MuJoCo at dt/4", threads, *r4, mj4))
         w, n = ragdoll
-        step = tumble_case("ragdoll", w, n, threads, args.repeat, record=False)
-        rec = tumble_case("ragdoll", w, n, threads, args.repeat, record=True)
-        rows.append((f"{w} ragdolls", threads, step, rec, None))
+        rows.append((f"{w} ragdolls", threads, *tumble_cases("ragdoll", w, n, threads, args.repeat), None))
     print()
-    head = ("case", "threads", "tumble step", "tumble simulate", "mujoco rollout", "simulate / rollout")
+    head = (
+        "case", "threads", "tumble step", "simulate", "simulate into out", "mujoco rollout",
+        "step / rollout", "simulate / rollout", "into out / rollout",
+    )
     print("| " + " | ".join(head) + " |")
     print("|" + "---|" * len(head))
-    for case, threads, step, rec, mj in rows:
-        ratio = f"{rec / mj:.2f}" if mj else "-"
+    for case, threads, step, rec, out, mj in rows:
+        ratios = " | ".join(f"{x / mj:.2f}" if mj else "-" for x in (step, rec, out))
         mjs = f"{mj:,.0f}" if mj else "-"
-        print(f"| {case} | {threads} | {step:,.0f} | {rec:,.0f} | {mjs} | {ratio} |")
+        print(f"| {case} | {threads} | {step:,.0f} | {rec:,.0f} | {out:,.0f} | {mjs} | {ratios} |")
     print("\nworld-steps per second (W × steps / s), best of", args.repeat)
     load = os.getloadavg()
     print(f"load average after: {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}")

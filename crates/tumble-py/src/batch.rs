@@ -9,17 +9,20 @@
 use std::sync::{Mutex, MutexGuard, TryLockError};
 use std::time::{Duration, Instant};
 
-use numpy::{AllowTypeChange, PyArrayLike1, PyArrayLike3};
+use numpy::{
+    AllowTypeChange, PyArrayDyn, PyArrayLike1, PyArrayLike3, PyArrayMethods, PyReadwriteArrayDyn,
+    PyUntypedArrayMethods,
+};
 use pyo3::exceptions::{PyKeyError, PyRuntimeError};
 use pyo3::intern;
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyBytes, PyDict, PyString};
+use pyo3::types::{PyBool, PyBytes, PyDict, PySlice, PyString};
 use tumble::{Batch, BodyKind, BodyStates, JointTarget, Quat, Real, StepFailure, Vec3, World};
 use tumble_scene::RunPlan;
 
 use crate::convert::wrong_type;
 use crate::convert::{engine, failed_step, invalid, not_real, real, scene, unreal_dtype, wide};
-use crate::sim::{array, push3, push4};
+use crate::sim::{array, push3, push4, Trajectory};
 use crate::world::{Inner, PyWorld};
 
 /// The batch and what its Python side keeps beside it.
@@ -311,12 +314,11 @@ fn run(
     py: Python<'_>,
     batch: &mut Batch,
     plan: &RunPlan,
-    mut frames: Option<&mut Frames>,
+    mut frames: Option<&mut Frames<'_>>,
 ) -> Result<(), Stop> {
     py.detach(|| {
         let w = batch.len();
         let block = w.min(WORLDS_PER_THREAD * batch.threads());
-        let mut rows: Vec<Rows> = (0..block).map(|_| Rows::default()).collect();
         let (mut k, mut chunk) = (0u64, 1u64);
         let mut last_check = Instant::now();
         let dt = |j: u64| {
@@ -330,22 +332,19 @@ fn run(
             let n = chunk.min(plan.steps - k);
             let (mut slowest, mut failed) = (Duration::ZERO, None);
             for first in (0..w).step_by(block) {
-                let each = &mut rows[..block.min(w - first)];
+                let b = block.min(w - first);
                 let began = Instant::now();
-                let outcome = match frames.as_deref() {
+                let steps = k + 1..k + n + 1;
+                let outcome = match frames.as_deref_mut() {
                     Some(f) => {
-                        batch.step_worlds(first, each, k + 1..k + n + 1, dt, |r, j, world| {
-                            if let Some(t) = f.frame_of(j) {
-                                r.record(t, world);
-                            }
+                        let mut each = f.slots(first, b, f.frames_of(k, n));
+                        batch.step_worlds(first, &mut each, steps, dt, |s, j, world| {
+                            s.record(j, world)
                         })
                     }
-                    None => batch.step_worlds(first, each, k + 1..k + n + 1, dt, |_, _, _| ()),
+                    None => batch.step_worlds(first, &mut vec![(); b], steps, dt, |_, _, _| ()),
                 };
                 slowest = slowest.max(began.elapsed());
-                if let Some(f) = frames.as_deref_mut() {
-                    f.take(first, each);
-                }
                 if let Err(e) = outcome {
                     failed.get_or_insert(e);
                 }
@@ -356,7 +355,7 @@ fn run(
             }
             if let Some(e) = failed {
                 if let Some(f) = frames.as_deref_mut() {
-                    f.truncate(k);
+                    f.keep_until(k);
                 }
                 return Err(Stop::Failed(e));
             }
@@ -831,117 +830,158 @@ impl PyBatch {
     }
 }
 
-/// A batch's recording: flat buffers of (T, W, N, ·).
-struct Frames {
+/// A batch's recording: (T, W, N, ·) arrays of position, orientation, velocity and
+/// angular velocity (fresh buffers, or the arrays of a trajectory given as `out`), which
+/// each world writes its rows into as it steps: one copy of each number, made by the
+/// thread stepping the world. (A first version gathered a chunk's rows per world and
+/// copied them in after; with fresh arrays each run, recording cost a tenth of a
+/// cart-pole's step on one thread and up to a fifth of the batch's speed on two.)
+struct Frames<'a> {
     /// Every `every`-th step is recorded, and the last (`steps`).
     every: u64,
     steps: u64,
     worlds: usize,
     bodies: usize,
-    time: Vec<f64>,
-    position: Vec<f64>,
-    orientation: Vec<f64>,
-    velocity: Vec<f64>,
-    angular_velocity: Vec<f64>,
+    /// Frames of the run; after a failed run, the frames recorded whole.
+    count: usize,
+    arrays: [&'a mut [f64]; 4],
 }
 
-impl Frames {
-    /// Room for every frame of a run of `plan`, step 0's filled in from `batch`.
-    fn new(batch: &Batch, plan: &RunPlan, every: u64) -> Frames {
-        let count = crate::sim::frame_count(plan.steps, every) as usize;
-        let (worlds, bodies) = (batch.len(), batch.body_ids().len());
-        let zeros = |width: usize| vec![0.0; count * worlds * bodies * width];
+/// Numbers a body takes in each of a recording's arrays.
+const WIDTHS: [usize; 4] = [3, 4, 3, 3];
+
+impl<'a> Frames<'a> {
+    /// A recording into `arrays` of `count` frames of `batch`, step 0's filled in.
+    fn new(batch: &Batch, plan: &RunPlan, every: u64, arrays: [&'a mut [f64]; 4]) -> Self {
         let mut f = Frames {
             every,
             steps: plan.steps,
-            worlds,
-            bodies,
-            time: (0..count as u64)
-                .map(|t| wide(plan.time_after((t * every).min(plan.steps))))
-                .collect(),
-            position: zeros(3),
-            orientation: zeros(4),
-            velocity: zeros(3),
-            angular_velocity: zeros(3),
+            worlds: batch.len(),
+            bodies: batch.body_ids().len(),
+            count: crate::sim::frame_count(plan.steps, every) as usize,
+            arrays,
         };
-        let mut r = Rows::default();
-        for (i, world) in batch.worlds().iter().enumerate() {
-            r.record(0, world);
-            f.take(i, std::slice::from_mut(&mut r));
+        for (s, world) in f.slots(0, batch.len(), 0..1).iter_mut().zip(batch.worlds()) {
+            s.record(0, world);
         }
         f
     }
 
-    /// The frame step `k` is recorded in, if it is.
-    fn frame_of(&self, k: u64) -> Option<usize> {
-        if k % self.every == 0 {
-            Some((k / self.every) as usize)
-        } else if k == self.steps {
-            Some((k / self.every + 1) as usize)
+    /// The frames that steps `k + 1..=k + n` are recorded in: the step k + 1 falls in
+    /// or after up to the one of step k + n (the last frame, when that is the last step).
+    fn frames_of(&self, k: u64, n: u64) -> std::ops::Range<usize> {
+        let end = if k + n >= self.steps {
+            self.count
         } else {
-            None
-        }
+            ((k + n) / self.every + 1) as usize
+        };
+        ((k / self.every + 1) as usize).min(end)..end
     }
 
-    /// Moves the rows recorded by worlds `first..` (one `Rows` each) to their frames.
-    fn take(&mut self, first: usize, each: &mut [Rows]) {
-        let (w, n) = (self.worlds, self.bodies);
-        for (i, r) in each.iter_mut().enumerate() {
-            for (j, &t) in r.frames.iter().enumerate() {
-                let at = t * w + first + i;
-                let copy = |to: &mut Vec<f64>, from: &[f64], width: usize| {
-                    let len = n * width;
-                    to[at * len..(at + 1) * len].copy_from_slice(&from[j * len..(j + 1) * len]);
-                };
-                copy(&mut self.position, &r.position, 3);
-                copy(&mut self.orientation, &r.orientation, 4);
-                copy(&mut self.velocity, &r.velocity, 3);
-                copy(&mut self.angular_velocity, &r.angular_velocity, 3);
-            }
-            r.clear();
-        }
+    /// Worlds `first..first + b`'s rows in `frames`, one `Slots` a world.
+    fn slots(&mut self, first: usize, b: usize, frames: std::ops::Range<usize>) -> Vec<Slots<'_>> {
+        let (w, n, start) = (self.worlds, self.bodies, frames.start);
+        let [p, q, v, a] = &mut self.arrays;
+        let [wp, wq, wv, wa] = WIDTHS;
+        let split = |array, width| rows_of(array, n * width, w, first..first + b, &frames);
+        let columns = [split(p, wp), split(q, wq), split(v, wv), split(a, wa)];
+        let (every, steps) = (self.every, self.steps);
+        let [p, q, v, a] = columns.map(|c| c.into_iter());
+        p.zip(q)
+            .zip(v.zip(a))
+            .map(
+                |((position, orientation), (velocity, angular_velocity))| Slots {
+                    first: start,
+                    every,
+                    steps,
+                    position,
+                    orientation,
+                    velocity,
+                    angular_velocity,
+                },
+            )
+            .collect()
     }
 
     /// Keeps the frames of steps 0..=`k` only.
-    fn truncate(&mut self, k: u64) {
-        let count = (k / self.every + 1) as usize;
-        let per = self.worlds * self.bodies;
-        self.time.truncate(count);
-        self.position.truncate(count * per * 3);
-        self.orientation.truncate(count * per * 4);
-        self.velocity.truncate(count * per * 3);
-        self.angular_velocity.truncate(count * per * 3);
+    fn keep_until(&mut self, k: u64) {
+        self.count = self.count.min((k / self.every + 1) as usize);
     }
 }
 
-/// One world's bodies at the frames it reached in a chunk of steps.
-#[derive(Default)]
-struct Rows {
-    frames: Vec<usize>,
-    position: Vec<f64>,
-    orientation: Vec<f64>,
-    velocity: Vec<f64>,
-    angular_velocity: Vec<f64>,
+/// The frame step `k` of a run of `steps` steps recording every `every`-th is recorded in,
+/// if it is.
+fn frame_of(k: u64, every: u64, steps: u64) -> Option<usize> {
+    if k % every == 0 {
+        Some((k / every) as usize)
+    } else if k == steps {
+        Some((k / every + 1) as usize)
+    } else {
+        None
+    }
 }
 
-impl Rows {
-    fn record(&mut self, frame: usize, world: &World) {
-        self.frames.push(frame);
-        for (_, b) in world.bodies() {
-            push3(&mut self.position, b.position());
-            push4(&mut self.orientation, b.orientation());
-            push3(&mut self.velocity, b.linear_velocity());
-            push3(&mut self.angular_velocity, b.angular_velocity());
+/// Worlds `worlds`' rows (`per` numbers each) in `frames` of a buffer of (T, W, per),
+/// a list of rows a world.
+fn rows_of<'a>(
+    buffer: &'a mut [f64],
+    per: usize,
+    w: usize,
+    worlds: std::ops::Range<usize>,
+    frames: &std::ops::Range<usize>,
+) -> Vec<Vec<&'a mut [f64]>> {
+    let len = frames.len();
+    let mut rows: Vec<Vec<&mut [f64]>> = worlds.clone().map(|_| Vec::with_capacity(len)).collect();
+    if per == 0 {
+        rows.iter_mut()
+            .for_each(|r| r.resize_with(len, Default::default));
+        return rows;
+    }
+    let chosen = &mut buffer[frames.start * w * per..frames.end * w * per];
+    for frame in chosen.chunks_mut(w * per) {
+        let each = frame[worlds.start * per..worlds.end * per].chunks_mut(per);
+        rows.iter_mut().zip(each).for_each(|(r, row)| r.push(row));
+    }
+    rows
+}
+
+/// One world's rows in the frames from `first` on: a row of N bodies in each array a
+/// frame.
+struct Slots<'a> {
+    first: usize,
+    every: u64,
+    steps: u64,
+    position: Vec<&'a mut [f64]>,
+    orientation: Vec<&'a mut [f64]>,
+    velocity: Vec<&'a mut [f64]>,
+    angular_velocity: Vec<&'a mut [f64]>,
+}
+
+impl Slots<'_> {
+    /// Writes `world`'s bodies into the frame of step `k`, if that step is recorded.
+    fn record(&mut self, k: u64, world: &World) {
+        let Some(t) = frame_of(k, self.every, self.steps).and_then(|f| f.checked_sub(self.first))
+        else {
+            return;
+        };
+        let (Some(p), Some(q), Some(v), Some(a)) = (
+            self.position.get_mut(t),
+            self.orientation.get_mut(t),
+            self.velocity.get_mut(t),
+            self.angular_velocity.get_mut(t),
+        ) else {
+            return;
+        };
+        let rows = p.chunks_exact_mut(3).zip(q.chunks_exact_mut(4));
+        let rates = v.chunks_exact_mut(3).zip(a.chunks_exact_mut(3));
+        for ((_, b), ((p, q), (v, a))) in world.bodies().zip(rows.zip(rates)) {
+            let (x, o) = (b.position(), b.orientation());
+            let (u, w) = (b.linear_velocity(), b.angular_velocity());
+            p.copy_from_slice(&[wide(x.x), wide(x.y), wide(x.z)]);
+            q.copy_from_slice(&[wide(o.x), wide(o.y), wide(o.z), wide(o.w)]);
+            v.copy_from_slice(&[wide(u.x), wide(u.y), wide(u.z)]);
+            a.copy_from_slice(&[wide(w.x), wide(w.y), wide(w.z)]);
         }
-    }
-
-    /// Empties the rows, keeping their room.
-    fn clear(&mut self) {
-        self.frames.clear();
-        self.position.clear();
-        self.orientation.clear();
-        self.velocity.clear();
-        self.angular_velocity.clear();
     }
 }
 
@@ -952,10 +992,14 @@ impl PyBatch {
     /// does, and returns a tumble.Trajectory whose arrays have a world axis: `time` (T,)
     /// (from the start of this run), `position` (T, W, N, 3), `orientation` (T, W, N, 4),
     /// `velocity` and `angular_velocity` (T, W, N, 3); step 0, every `every`-th step and
-    /// the last are recorded. The loop runs with the interpreter's lock released. A
-    /// failed step raises SimulationError naming the world, whose `trajectory` holds the
-    /// frames recorded before it.
-    #[pyo3(signature = (duration = None, dt = None, *, steps = None, every = None))]
+    /// the last are recorded. Given `out`, a Trajectory of an earlier Batch.simulate with
+    /// the arrays this run records (same T, W and N), its arrays are overwritten and it
+    /// is returned: a loop of rollouts allocates nothing (as MuJoCo's rollout writes into
+    /// the `state` array it is given); no other thread may touch those arrays meanwhile.
+    /// The loop runs with the interpreter's lock released. A failed step raises
+    /// SimulationError naming the world, whose `trajectory` holds the frames recorded
+    /// before it (views of `out`'s arrays when given).
+    #[pyo3(signature = (duration = None, dt = None, *, steps = None, every = None, out = None))]
     fn simulate(
         &self,
         py: Python<'_>,
@@ -963,7 +1007,8 @@ impl PyBatch {
         dt: Option<f64>,
         steps: Option<&Bound<'_, PyAny>>,
         every: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<crate::sim::Trajectory> {
+        out: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Py<Trajectory>> {
         let every = u64::try_from(every.map_or(Ok(1), |e| whole(e, "every"))?)
             .ok()
             .filter(|&e| e >= 1)
@@ -984,29 +1029,173 @@ impl PyBatch {
                 "duration",
             ),
         };
-        let (w, n) = (g.batch.len(), g.batch.body_ids().len());
-        let frames = crate::sim::frame_count(plan.steps, every);
-        crate::sim::check_fits(py, field, frames, w.saturating_mul(n), false)?;
-        let mut rec = Frames::new(&g.batch, &plan, every);
-        let outcome = run(py, &mut g.batch, &plan, Some(&mut rec));
-        let t = rec.time.len();
-        let traj = crate::sim::Trajectory::of_frames(
-            py,
-            [
-                rec.time,
-                rec.position,
-                rec.orientation,
-                rec.velocity,
-                rec.angular_velocity,
-            ],
-            &[t, w, n],
-            g.names.clone(),
-        )?;
-        match outcome {
-            Ok(()) => Ok(traj),
-            Err(Stop::Failed(f)) => Err(failure(py, &f, Some(Py::new(py, traj)?.into_any()))),
-            Err(Stop::Python(e)) => Err(e),
+        let run = Recorded { plan, every };
+        match out.filter(|o| !o.is_none()) {
+            Some(out) => run.into_out(py, &mut g, out),
+            None => {
+                let (w, n) = (g.batch.len(), g.batch.body_ids().len());
+                let frames = crate::sim::frame_count(plan.steps, every);
+                crate::sim::check_fits(py, field, frames, w.saturating_mul(n), false)?;
+                run.into_new(py, &mut g)
+            }
         }
+    }
+}
+
+/// A recorded run of `Batch.simulate`.
+struct Recorded {
+    plan: RunPlan,
+    every: u64,
+}
+
+impl Recorded {
+    /// (T, W, N): the frames, worlds and bodies recorded.
+    fn lead(&self, g: &BatchInner) -> [usize; 3] {
+        let t = crate::sim::frame_count(self.plan.steps, self.every) as usize;
+        [t, g.batch.len(), g.batch.body_ids().len()]
+    }
+
+    /// The time of each of the first `count` frames, from the start of the run.
+    fn times(&self, count: usize) -> impl Iterator<Item = f64> + '_ {
+        let (plan, every) = (&self.plan, self.every);
+        (0..count as u64).map(move |t| wide(plan.time_after((t * every).min(plan.steps))))
+    }
+
+    /// Runs the batch, recording into `arrays`; the frames recorded whole.
+    fn record(
+        &self,
+        py: Python<'_>,
+        g: &mut BatchInner,
+        arrays: [&mut [f64]; 4],
+    ) -> (Result<(), Stop>, usize) {
+        let mut rec = Frames::new(&g.batch, &self.plan, self.every, arrays);
+        let outcome = run(py, &mut g.batch, &self.plan, Some(&mut rec));
+        (outcome, rec.count)
+    }
+
+    /// The run recorded into fresh arrays, returned as a new Trajectory.
+    fn into_new(self, py: Python<'_>, g: &mut BatchInner) -> PyResult<Py<Trajectory>> {
+        let [t, w, n] = self.lead(g);
+        let mut arrays = WIDTHS.map(|width| vec![0.0; t * w * n * width]);
+        let (outcome, kept) = self.record(py, g, arrays.each_mut().map(|a| a.as_mut_slice()));
+        for (a, width) in arrays.iter_mut().zip(WIDTHS) {
+            a.truncate(kept * w * n * width);
+        }
+        let [p, q, v, a] = arrays;
+        let time = self.times(kept).collect();
+        let traj = Trajectory::of_frames(py, [time, p, q, v, a], &[kept, w, n], g.names.clone())?;
+        finished(py, outcome, Py::new(py, traj)?)
+    }
+
+    /// The run recorded into the arrays of `out`, a Trajectory of the same shapes,
+    /// returned.
+    fn into_out(
+        self,
+        py: Python<'_>,
+        g: &mut BatchInner,
+        out: &Bound<'_, PyAny>,
+    ) -> PyResult<Py<Trajectory>> {
+        let traj = out
+            .cast::<Trajectory>()
+            .map_err(|_| wrong_type("out", "a tumble.Trajectory from Batch.simulate", out))?;
+        let [t, w, n] = self.lead(g);
+        let [time, p, q, v, a] = traj.get().arrays();
+        let mut time = writable(py, time, "out.time", &[t])?;
+        let shape = |width| [t, w, n, width];
+        let mut p = writable(py, p, "out.position", &shape(3))?;
+        let mut q = writable(py, q, "out.orientation", &shape(4))?;
+        let mut v = writable(py, v, "out.velocity", &shape(3))?;
+        let mut a = writable(py, a, "out.angular_velocity", &shape(3))?;
+        for (to, from) in slice(&mut time)?.iter_mut().zip(self.times(t)) {
+            *to = from;
+        }
+        let arrays = [
+            slice(&mut p)?,
+            slice(&mut q)?,
+            slice(&mut v)?,
+            slice(&mut a)?,
+        ];
+        let (outcome, kept) = self.record(py, g, arrays);
+        drop((time, p, q, v, a));
+        if kept == t {
+            return finished(py, outcome, traj.clone().unbind());
+        }
+        let head = |a: &Py<PyAny>| -> PyResult<Py<PyAny>> {
+            Ok(a.bind(py)
+                .get_item(PySlice::new(py, 0, kept as isize, 1))?
+                .unbind())
+        };
+        let arrays = traj.get().arrays();
+        let [time, p, q, v, a] = [
+            head(arrays[0])?,
+            head(arrays[1])?,
+            head(arrays[2])?,
+            head(arrays[3])?,
+            head(arrays[4])?,
+        ];
+        let heads = Trajectory::of_arrays([time, p, q, v, a], g.names.clone());
+        finished(py, outcome, Py::new(py, heads)?)
+    }
+}
+
+/// `array`, to be written by a run: a writable C-contiguous float64 array of `shape`,
+/// else refused naming `field`.
+fn writable<'py>(
+    py: Python<'py>,
+    array: &Py<PyAny>,
+    field: &str,
+    shape: &[usize],
+) -> PyResult<PyReadwriteArrayDyn<'py, f64>> {
+    let text = |s: &[usize]| match s {
+        [one] => format!("({one},)"),
+        _ => format!(
+            "({})",
+            s.iter()
+                .map(|d| d.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
+    let refuse = |got: String| {
+        invalid(
+            field,
+            format!(
+                "must be a writable C-contiguous float64 array of shape {}, the frames this \
+                 run records; got {got}",
+                text(shape)
+            ),
+        )
+    };
+    let Ok(a) = array.bind(py).cast::<PyArrayDyn<f64>>() else {
+        return Err(refuse("an array of another type".into()));
+    };
+    if a.shape() != shape {
+        return Err(refuse(format!("shape {}", text(a.shape()))));
+    }
+    if !a.is_c_contiguous() {
+        return Err(refuse("an array that is not C-contiguous".into()));
+    }
+    a.try_readwrite()
+        .map_err(|_| refuse("an array that is read-only or borrowed".into()))
+}
+
+/// A writable array's numbers (checked C-contiguous by `writable`).
+fn slice<'b>(array: &'b mut PyReadwriteArrayDyn<'_, f64>) -> PyResult<&'b mut [f64]> {
+    array
+        .as_slice_mut()
+        .map_err(|_| invalid("out", "its arrays must be C-contiguous"))
+}
+
+/// A run's outcome as Python sees it: `traj`, or the step's failure carrying it.
+fn finished(
+    py: Python<'_>,
+    outcome: Result<(), Stop>,
+    traj: Py<Trajectory>,
+) -> PyResult<Py<Trajectory>> {
+    match outcome {
+        Ok(()) => Ok(traj),
+        Err(Stop::Failed(f)) => Err(failure(py, &f, Some(traj.into_any()))),
+        Err(Stop::Python(e)) => Err(e),
     }
 }
 

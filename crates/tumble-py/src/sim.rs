@@ -71,19 +71,46 @@ impl Trajectory {
     ) -> PyResult<Trajectory> {
         let [time, position, orientation, velocity, angular_velocity] = data;
         let shape = |width: usize| [lead, &[width]].concat();
-        Ok(Trajectory {
-            time: array(py, time, &lead[..1])?,
-            position: array(py, position, &shape(3))?,
-            orientation: array(py, orientation, &shape(4))?,
-            velocity: array(py, velocity, &shape(3))?,
-            angular_velocity: array(py, angular_velocity, &shape(3))?,
+        Ok(Trajectory::of_arrays(
+            [
+                array(py, time, &lead[..1])?,
+                array(py, position, &shape(3))?,
+                array(py, orientation, &shape(4))?,
+                array(py, velocity, &shape(3))?,
+                array(py, angular_velocity, &shape(3))?,
+            ],
+            names,
+        ))
+    }
+
+    /// A trajectory of these arrays of time, position, orientation, velocity and angular
+    /// velocity, without diagnostics.
+    pub(crate) fn of_arrays(arrays: [Py<PyAny>; 5], names: Vec<Option<String>>) -> Trajectory {
+        let [time, position, orientation, velocity, angular_velocity] = arrays;
+        Trajectory {
+            time,
+            position,
+            orientation,
+            velocity,
+            angular_velocity,
             kinetic: None,
             potential: None,
             total: None,
             linear_momentum: None,
             angular_momentum: None,
             names,
-        })
+        }
+    }
+
+    /// Its arrays of time, position, orientation, velocity and angular velocity.
+    pub(crate) fn arrays(&self) -> [&Py<PyAny>; 5] {
+        [
+            &self.time,
+            &self.position,
+            &self.orientation,
+            &self.velocity,
+            &self.angular_velocity,
+        ]
     }
 }
 

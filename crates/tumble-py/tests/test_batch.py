@@ -387,3 +387,92 @@ def test_step_releases_the_interpreter():
     thread.join()
     assert count > 1000
     assert batch.step_counts == [300] * 4
+
+
+@pytest.mark.parametrize("steps,every", [(5, 10), (10, 5), (0, 1), (7, 7)])
+def test_recording_edges_empty_worlds_and_runs_shorter_than_every(steps, every):
+    # A world without bodies records its (empty) rows; a run shorter than `every` keeps
+    # step 0 and the last; a run of 0 steps keeps step 0 only.
+    empty = tumble.Batch(tumble.World(), copies=3, threads=2)
+    traj = empty.simulate(steps=steps, dt=0.01, every=every)
+    frames = steps // every + 1 + (steps % every != 0)
+    assert traj.position.shape == (frames, 3, 0, 3)
+    assert traj.orientation.shape == (frames, 3, 0, 4)
+    batch = tumble.Batch(CART_POLE, copies=3, threads=2)
+    world = world_of(CART_POLE)
+    a = batch.simulate(steps=steps, dt=0.01, every=every)
+    b = world.simulate(steps=steps, dt=0.01, every=every)
+    assert a.position.shape == (frames, 3, 2, 3)
+    np.testing.assert_array_equal(a.time, b.time)
+    for i in range(3):
+        assert np.array_equal(a.position[:, i], b.position)
+        assert np.array_equal(a.orientation[:, i], b.orientation)
+        assert np.array_equal(a.velocity[:, i], b.velocity)
+
+
+@pytest.mark.parametrize("threads,every", [(1, 1), (2, 3)])
+def test_simulate_into_out_overwrites_its_arrays_with_the_same_frames(threads, every):
+    # A recording into an earlier run's arrays equals a fresh one bit for bit, and is
+    # that trajectory (the same array objects), so a loop of rollouts allocates nothing.
+    def batch():
+        b = tumble.Batch(CART_POLE, copies=19, threads=threads)
+        b.randomize(np.random.default_rng(4), velocities=0.3)
+        return b
+
+    fresh = batch().simulate(steps=41, dt=0.01, every=every)
+    out = batch().simulate(steps=41, dt=0.005, every=every)  # other numbers, same shapes
+    arrays = [out.time, out.position, out.orientation, out.velocity, out.angular_velocity]
+    again = batch().simulate(steps=41, dt=0.01, every=every, out=out)
+    assert again is out
+    for name, a in zip(["time", "position", "orientation", "velocity"], arrays):
+        assert getattr(again, name) is a
+        assert np.array_equal(a, getattr(fresh, name)), name
+    assert np.array_equal(again.angular_velocity, fresh.angular_velocity)
+
+
+def test_simulate_into_out_refuses_arrays_of_another_run():
+    batch = tumble.Batch(CART_POLE, copies=3)
+    out = batch.simulate(steps=10, dt=0.01)
+    world = world_of(CART_POLE)
+    for kwargs, error, text in [
+        ({"steps": 5}, ValueError, "out.time: must be a writable C-contiguous float64 "
+         "array of shape (6,), the frames this run records; got shape (11,)"),
+        ({"steps": 10, "every": 2}, ValueError, "out.time: must be a writable"),
+        ({"steps": 10, "out": world.simulate(steps=10, dt=0.01)}, ValueError,
+         "out.position: must be a writable C-contiguous float64 array of shape "
+         "(11, 3, 2, 3), the frames this run records; got shape (11, 2, 3)"),
+        ({"steps": 10, "out": {"time": 1}}, TypeError,
+         "out: expected a tumble.Trajectory from Batch.simulate, got dict"),
+    ]:
+        kwargs.setdefault("out", out)
+        with pytest.raises(error) as e:
+            batch.simulate(dt=0.01, **kwargs)
+        assert str(e.value).startswith(text), str(e.value)
+    assert batch.step_counts == [10] * 3  # nothing ran
+    out.velocity.flags.writeable = False
+    with pytest.raises(ValueError, match="out.velocity: .* got an array that is read-only"):
+        batch.simulate(steps=10, dt=0.01, out=out)
+    assert batch.step_counts == [10] * 3
+
+
+def test_a_failed_run_into_out_reports_the_frames_before_it():
+    world = tumble.World(gravity=(0, 0, 0))
+    world.add_body(tumble.Sphere(0.1), mass=1.0)
+    batch = tumble.Batch(world, copies=3, threads=2)
+    out = batch.simulate(steps=20, dt=0.01)
+    forces = np.zeros((3, 1, 3))
+    forces[1, 0, 0] = 1e9  # past the speed limit within a few steps
+    batch.apply_forces(forces)
+    with pytest.raises(tumble.SimulationError) as fresh:
+        batch.simulate(steps=20, dt=0.01)
+    batch.reset()
+    batch.simulate(steps=20, dt=0.01, out=out)
+    batch.reset()
+    batch.apply_forces(forces)
+    with pytest.raises(tumble.SimulationError) as into:
+        batch.simulate(steps=20, dt=0.01, out=out)
+    a, b = fresh.value.trajectory, into.value.trajectory
+    assert 1 <= len(b.time) < 21 and b.position.shape == a.position.shape
+    assert np.shares_memory(b.position, out.position)
+    for name in ["time", "position", "orientation", "velocity", "angular_velocity"]:
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name

@@ -961,10 +961,13 @@ class Batch:
         *,
         steps: Optional[int] = None,
         every: int = 1,
+        out: Optional[Trajectory] = None,
     ) -> Trajectory:
         """Runs every world as World.simulate does; the Trajectory's arrays have a world
         axis: position (T, W, N, 3), orientation (T, W, N, 4), velocity and
-        angular_velocity (T, W, N, 3), time (T,)."""
+        angular_velocity (T, W, N, 3), time (T,). Given `out` (a Trajectory of an earlier
+        Batch.simulate with the same T, W and N), its arrays are overwritten in place and
+        it is returned, so a loop of rollouts allocates nothing."""
 
 class Push:
     """An impulse a character's move gave a dynamic body in its way."""
