@@ -277,10 +277,7 @@ impl Solver {
     fn finish_trees(&mut self, input: &mut StepInput<'_, '_>, bodies: &mut SolverBodies) {
         let time = input.time;
         if !self.trees.is_empty() {
-            let (sims, states) = (&mut bodies.sims, &mut bodies.states);
-            let world_bodies = input.system.bodies;
-            self.trees
-                .finish(world_bodies, sims, states, input.joints, time.substeps);
+            (self.trees).finish(&mut bodies.sims, input.joints, time.substeps);
         }
     }
 

@@ -14,15 +14,17 @@
 //! quantity. Undoing is cheap because of the step's shape: bodies are written back only by
 //! `scatter`, after the check, so they need nothing; the contact cache built its new
 //! contacts beside last step's and swaps back; what remains (the sleep state
-//! `wake_touched` changes, the joints' warm starts and broken flags, the integrator's
-//! memory, the kinematic targets taken) is copied before the stages run, about 30 bytes per body and the joint list.
+//! `wake_touched` changes, the joints' warm starts, reactions and broken flags, the
+//! integrator's memory, the kinematic targets taken) is copied before the stages run,
+//! about 30 bytes per body and 160 per joint. (Whole joints were copied before: a ninth
+//! of a cart-pole's step in reduced coordinates, for fields no stage writes.)
 //! Force callbacks are the user's code and are not undone. A callback that stops the
 //! step (`ForceContext::fail`, how Python's exceptions leave a callback) has the step
 //! undone the same way, by `check_callbacks` right after the stage that called it.
 
 use crate::dynamics::body::{Body, BodyKind};
 use crate::dynamics::integrate::IntegratorMemory;
-use crate::dynamics::joint::Joint;
+use crate::dynamics::joint::{Joint, JointImpulses};
 use crate::dynamics::solver::{SolverBodies, StepTime};
 use crate::error::{CallbackFailed, Error, Result, TooManyContacts, Unstable};
 use crate::limits::{short, SpeedLimits, MAX_COORDINATE};
@@ -34,11 +36,36 @@ use crate::pipeline::world::World;
 pub(crate) struct Undo {
     /// Per body: awake, sleep timer.
     sleep: Vec<(bool, Real)>,
-    joints: Vec<Joint>,
+    joints: Vec<JointUndo>,
     memory: IntegratorMemory,
     /// The kinematic targets the step took: body, target, velocity and angular velocity
     /// before (see `take_kinematic_targets`).
     pub(super) targets: Vec<(usize, (Vec3, Quat), Vec3, Vec3)>,
+}
+
+/// What a step's stages write in a joint before its check (the solver's warm starts,
+/// reactions and a break; the hinge angle is followed after the check).
+#[derive(Clone, Copy)]
+struct JointUndo {
+    impulses: JointImpulses,
+    reaction: (Vec3, Vec3),
+    broken: bool,
+}
+
+impl JointUndo {
+    fn of(j: &Joint) -> JointUndo {
+        JointUndo {
+            impulses: j.impulses,
+            reaction: (j.reaction_force, j.reaction_torque),
+            broken: j.broken,
+        }
+    }
+
+    fn restore(&self, j: &mut Joint) {
+        j.impulses = self.impulses;
+        (j.reaction_force, j.reaction_torque) = self.reaction;
+        j.broken = self.broken;
+    }
 }
 
 impl World {
@@ -48,7 +75,9 @@ impl World {
         undo.sleep.clear();
         undo.sleep
             .extend(self.bodies.list.iter().map(|b| (b.awake, b.sleep_time)));
-        undo.joints.clone_from(&self.joints.list);
+        undo.joints.clear();
+        undo.joints
+            .extend(self.joints.list.iter().map(JointUndo::of));
         undo.memory.clone_from(&self.memory);
         undo.targets.clear();
     }
@@ -109,7 +138,9 @@ impl World {
             b.awake = awake;
             b.sleep_time = sleep_time;
         }
-        std::mem::swap(&mut self.joints.list, &mut undo.joints);
+        for (j, kept) in self.joints.list.iter_mut().zip(&undo.joints) {
+            kept.restore(j);
+        }
         std::mem::swap(&mut self.memory, &mut undo.memory);
         for &(i, target, v, w) in &undo.targets {
             let b = &mut self.bodies.list[i];
