@@ -26,7 +26,9 @@ outside the timing), so Tumble is timed three ways: `step` (nothing recorded),
 `simulate(every=1)` (every step's positions, orientations, velocities and angular
 velocities recorded into new arrays) and `simulate(every=1, out=...)` (recorded into the
 arrays of an earlier run, as rollout does). The figures are the best of `--repeat` runs
-(default 3), as world-steps per second = W × steps / seconds.
+(default 3), as world-steps per second = W × steps / seconds; every case of a thread
+count takes its turn in each round (`interleaved`), so that the machine's slow spells
+fall on Tumble and MuJoCo alike.
 
 Same dt is not same accuracy, so the script also measures each run's error on a pole let
 go 1 rad from upright (`accuracy`: RMS error over 2 s against MuJoCo's RK4 at 1e-5 s) and
@@ -95,19 +97,24 @@ CART_POLE_MJCF = """
 """
 
 
-def best(fn, repeat):
-    """The shortest of `repeat` timed calls of fn() (each after an untimed setup)."""
-    times = []
+def interleaved(cases, repeat):
+    """World-steps per second of each case, the best of `repeat` timed calls. A case is
+    (world-steps a call, setup) where setup() returns the call (untimed). The cases take
+    turns, round after round, so that a slow spell of the machine (this 2-core VM's speed
+    wanders by half from minute to minute) falls on all of them alike rather than on
+    whichever ran then."""
+    times = [[] for _ in cases]
     for _ in range(repeat):
-        run = fn()
-        t0 = time.perf_counter()
-        run()
-        times.append(time.perf_counter() - t0)
-    return min(times)
+        for (_, setup), t in zip(cases, times):
+            run = setup()
+            t0 = time.perf_counter()
+            run()
+            t.append(time.perf_counter() - t0)
+    return [work / min(t) for (work, _), t in zip(cases, times)]
 
 
-def tumble_case(scene, copies, steps, threads, repeat, record, kick=0.05):
-    """World-steps per second of Tumble's batch: `record` None (`step`), "new"
+def tumble_case(scene, copies, steps, threads, record, kick=0.05):
+    """Tumble's batch as a case of `interleaved`: `record` None (`step`), "new"
     (`simulate` into new arrays) or "out" (`simulate` into an earlier run's arrays)."""
 
     def batch():
@@ -125,24 +132,25 @@ def tumble_case(scene, copies, steps, threads, repeat, record, kick=0.05):
             return lambda: b.simulate(steps=steps, every=1)
         return lambda: b.step(steps=steps)
 
-    return copies * steps / best(setup, repeat)
+    return copies * steps, setup
 
 
-def tumble_cases(scene, copies, steps, threads, repeat):
+def tumble_cases(scene, copies, steps, threads):
     """`tumble_case` for each way of recording: step, simulate, simulate into out."""
-    return [tumble_case(scene, copies, steps, threads, repeat, r) for r in (None, "new", "out")]
+    return [tumble_case(scene, copies, steps, threads, r) for r in (None, "new", "out")]
 
 
-def mujoco_case(copies, steps, threads, repeat, integrator="EULER", split=1):
-    """World-steps of 0.01 s per second of MuJoCo's rollout, each 0.01 s taken as `split`
-    steps of 0.01 / split with `integrator` (mjINT_ + its name)."""
+def mujoco_case(pools, copies, steps, threads, integrator="EULER", split=1):
+    """MuJoCo's rollout as a case of `interleaved`, counted in world-steps of 0.01 s,
+    each 0.01 s taken as `split` steps of 0.01 / split with `integrator` (mjINT_ + its
+    name). Its thread pool is added to `pools` (to be closed by the caller)."""
     import mujoco
     from mujoco import rollout
 
     model = mujoco.MjModel.from_xml_string(CART_POLE_MJCF)
     model.opt.timestep = 0.01 / split
     model.opt.integrator = getattr(mujoco.mjtIntegrator, "mjINT_" + integrator)
-    steps *= split
+    nstep = steps * split
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     data = mujoco.MjData(model)
     size = mujoco.mj_stateSize(model, spec)
@@ -152,26 +160,26 @@ def mujoco_case(copies, steps, threads, repeat, integrator="EULER", split=1):
         mujoco.mj_resetData(model, data)
         data.qvel[:] = rng.uniform(-0.05, 0.05, model.nv)
         mujoco.mj_getState(model, data, initial[i], spec)
-    control = np.zeros((copies, steps, model.nu))
-    state = np.empty((copies, steps, size))
-    sensordata = np.empty((copies, steps, model.nsensordata))
+    control = np.zeros((copies, nstep, model.nu))
+    state = np.empty((copies, nstep, size))
+    sensordata = np.empty((copies, nstep, model.nsensordata))
     datas = [mujoco.MjData(model) for _ in range(max(threads, 1))]
     # nthread = 0: the calling thread steps every world (MuJoCo's own 1-thread case).
-    nthread = 0 if threads == 1 else threads
-    with rollout.Rollout(nthread=nthread) as pool:
+    pool = rollout.Rollout(nthread=0 if threads == 1 else threads)
+    pools.append(pool)
 
-        def setup():
-            return lambda: pool.rollout(
-                model,
-                datas,
-                initial,
-                control,
-                nstep=steps,
-                state=state,
-                sensordata=sensordata,
-            )
+    def setup():
+        return lambda: pool.rollout(
+            model,
+            datas,
+            initial,
+            control,
+            nstep=nstep,
+            state=state,
+            sensordata=sensordata,
+        )
 
-        return copies * steps / split / best(setup, repeat)
+    return copies * steps, setup
 
 
 def swinging(theta, substeps):
@@ -237,25 +245,34 @@ def main():
     rows = []
     for threads in (1, 2):
         w, n = cart
-        four = tumble_cases(CART_POLE, w, n, threads, args.repeat)
-        one = tumble_cases(CART_POLE_1, w, n, threads, args.repeat)
-        mj = mujoco_case(w, n, threads, args.repeat)
-        rows.append((f"{w} cart-poles", threads, *four, mj))
-        rows.append((f"{w} cart-poles, 1 substep", threads, *one, mj))
-        # At matched accuracy (see `accuracy`): MuJoCo's Euler needs dt / 4 to come as
-        # close as Tumble's 1 substep; its RK4 at dt beats Tumble's 4 substeps.
-        mj4 = mujoco_case(w, n, threads, args.repeat, split=4)
-        rows.append((f"{w} cart-poles, 1 substep; MuJoCo Euler at dt/4", threads, *one, mj4))
-        rk4 = mujoco_case(w, n, threads, args.repeat, integrator="RK4")
-        rows.append((f"{w} cart-poles; MuJoCo RK4", threads, *four, rk4))
-        # Reduced trees: the same scheme as MuJoCo's Euler, so the same dt is the same
-        # accuracy: at dt (1 substep) and at dt / 4 (4 substeps).
-        r1 = tumble_cases(REDUCED_1, w, n, threads, args.repeat)
-        r4 = tumble_cases(REDUCED_4, w, n, threads, args.repeat)
-        rows.append((f"{w} cart-poles, reduced, 1 substep", threads, *r1, mj))
-        rows.append((f"{w} cart-poles, reduced, 4 substeps; MuJoCo at dt/4", threads, *r4, mj4))
-        w, n = ragdoll
-        rows.append((f"{w} ragdolls", threads, *tumble_cases("ragdoll", w, n, threads, args.repeat), None))
+        pools = []
+        cases = {
+            "four": tumble_cases(CART_POLE, w, n, threads),
+            "one": tumble_cases(CART_POLE_1, w, n, threads),
+            # Reduced trees: the same scheme as MuJoCo's Euler, so the same dt is the
+            # same accuracy: at dt (1 substep) and at dt / 4 (4 substeps).
+            "r1": tumble_cases(REDUCED_1, w, n, threads),
+            "r4": tumble_cases(REDUCED_4, w, n, threads),
+            "mj": [mujoco_case(pools, w, n, threads)],
+            # At matched accuracy (see `accuracy`): MuJoCo's Euler needs dt / 4 to come
+            # as close as Tumble's 1 substep; its RK4 at dt beats Tumble's 4 substeps.
+            "mj4": [mujoco_case(pools, w, n, threads, split=4)],
+            "rk4": [mujoco_case(pools, w, n, threads, integrator="RK4")],
+            "ragdoll": tumble_cases("ragdoll", *ragdoll, threads),
+        }
+        flat = [c for group in cases.values() for c in group]
+        rates = iter(interleaved(flat, args.repeat))
+        got = {k: [next(rates) for _ in group] for k, group in cases.items()}
+        for pool in pools:
+            pool.close()
+        (mj,), (mj4,), (rk4,) = got["mj"], got["mj4"], got["rk4"]
+        rows.append((f"{w} cart-poles", threads, *got["four"], mj))
+        rows.append((f"{w} cart-poles, 1 substep", threads, *got["one"], mj))
+        rows.append((f"{w} cart-poles, 1 substep; MuJoCo Euler at dt/4", threads, *got["one"], mj4))
+        rows.append((f"{w} cart-poles; MuJoCo RK4", threads, *got["four"], rk4))
+        rows.append((f"{w} cart-poles, reduced, 1 substep", threads, *got["r1"], mj))
+        rows.append((f"{w} cart-poles, reduced, 4 substeps; MuJoCo at dt/4", threads, *got["r4"], mj4))
+        rows.append((f"{ragdoll[0]} ragdolls", threads, *got["ragdoll"], None))
     print()
     head = (
         "case", "threads", "tumble step", "simulate", "simulate into out", "mujoco rollout",
@@ -267,7 +284,7 @@ def main():
         ratios = " | ".join(f"{x / mj:.2f}" if mj else "-" for x in (step, rec, out))
         mjs = f"{mj:,.0f}" if mj else "-"
         print(f"| {case} | {threads} | {step:,.0f} | {rec:,.0f} | {out:,.0f} | {mjs} | {ratios} |")
-    print("\nworld-steps per second (W × steps / s), best of", args.repeat)
+    print("\nworld-steps per second (W × steps / s), best of", args.repeat, "(interleaved)")
     load = os.getloadavg()
     print(f"load average after: {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}")
     print(json.dumps({r[0] + f" x{r[1]}": r[2:] for r in rows}))
