@@ -10,8 +10,8 @@ use std::sync::{Mutex, MutexGuard, TryLockError};
 use std::time::{Duration, Instant};
 
 use numpy::{
-    AllowTypeChange, PyArrayDyn, PyArrayLike1, PyArrayLike3, PyArrayMethods, PyReadwriteArrayDyn,
-    PyUntypedArrayMethods,
+    AllowTypeChange, PyArray1, PyArrayDyn, PyArrayLike1, PyArrayLike3, PyArrayMethods,
+    PyReadwriteArrayDyn, PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{PyKeyError, PyRuntimeError};
 use pyo3::intern;
@@ -830,20 +830,24 @@ impl PyBatch {
     }
 }
 
-/// A batch's recording: (T, W, N, ·) arrays of position, orientation, velocity and
-/// angular velocity (fresh buffers, or the arrays of a trajectory given as `out`), which
-/// each world writes its rows into as it steps: one copy of each number, made by the
-/// thread stepping the world. (A first version gathered a chunk's rows per world and
-/// copied them in after; with fresh arrays each run, recording cost a tenth of a
-/// cart-pole's step on one thread and up to a fifth of the batch's speed on two.)
+/// A batch's recording: position, orientation, velocity and angular velocity, each
+/// stored world by world, (W, T, N, ·), and seen by Python as (T, W, N, ·) (the first two
+/// axes swapped: a view, no copy). Each world writes its rows as it steps, one after
+/// another in its own stretch of each array, on the thread stepping it.
+///
+/// Why so: the first version gathered a chunk's rows per world and copied them into
+/// time-major (T, W, N, ·) arrays; writing straight into those, every step of a world
+/// stored into four new cache lines 48 kB apart, and two threads recording 1,024
+/// cart-poles ran at 0.8 of their speed unrecorded. MuJoCo's rollout writes (W, T, ·).
 struct Frames<'a> {
     /// Every `every`-th step is recorded, and the last (`steps`).
     every: u64,
     steps: u64,
-    worlds: usize,
     bodies: usize,
     /// Frames of the run; after a failed run, the frames recorded whole.
     count: usize,
+    /// The frames each world has room for (`count` before a failure).
+    room: usize,
     arrays: [&'a mut [f64]; 4],
 }
 
@@ -851,14 +855,16 @@ struct Frames<'a> {
 const WIDTHS: [usize; 4] = [3, 4, 3, 3];
 
 impl<'a> Frames<'a> {
-    /// A recording into `arrays` of `count` frames of `batch`, step 0's filled in.
+    /// A recording into `arrays` (W, T, N, ·) of a run of `plan` of `batch`, step 0's
+    /// filled in.
     fn new(batch: &Batch, plan: &RunPlan, every: u64, arrays: [&'a mut [f64]; 4]) -> Self {
+        let count = crate::sim::frame_count(plan.steps, every) as usize;
         let mut f = Frames {
             every,
             steps: plan.steps,
-            worlds: batch.len(),
             bodies: batch.body_ids().len(),
-            count: crate::sim::frame_count(plan.steps, every) as usize,
+            count,
+            room: count,
             arrays,
         };
         for (s, world) in f.slots(0, batch.len(), 0..1).iter_mut().zip(batch.worlds()) {
@@ -871,36 +877,37 @@ impl<'a> Frames<'a> {
     /// or after up to the one of step k + n (the last frame, when that is the last step).
     fn frames_of(&self, k: u64, n: u64) -> std::ops::Range<usize> {
         let end = if k + n >= self.steps {
-            self.count
+            self.room
         } else {
             ((k + n) / self.every + 1) as usize
         };
         ((k / self.every + 1) as usize).min(end)..end
     }
 
-    /// Worlds `first..first + b`'s rows in `frames`, one `Slots` a world.
+    /// Worlds `first..first + b`'s rows of `frames`, one `Slots` a world.
     fn slots(&mut self, first: usize, b: usize, frames: std::ops::Range<usize>) -> Vec<Slots<'_>> {
-        let (w, n, start) = (self.worlds, self.bodies, frames.start);
-        let [p, q, v, a] = &mut self.arrays;
-        let [wp, wq, wv, wa] = WIDTHS;
-        let split = |array, width| rows_of(array, n * width, w, first..first + b, &frames);
-        let columns = [split(p, wp), split(q, wq), split(v, wv), split(a, wa)];
+        let (n, room, start) = (self.bodies, self.room, frames.start);
         let (every, steps) = (self.every, self.steps);
-        let [p, q, v, a] = columns.map(|c| c.into_iter());
-        p.zip(q)
-            .zip(v.zip(a))
-            .map(
-                |((position, orientation), (velocity, angular_velocity))| Slots {
-                    first: start,
-                    every,
-                    steps,
-                    position,
-                    orientation,
-                    velocity,
-                    angular_velocity,
-                },
-            )
-            .collect()
+        let mut each: Vec<Slots<'_>> = (0..b)
+            .map(|_| Slots {
+                first: start,
+                every,
+                steps,
+                bodies: n,
+                rows: Default::default(),
+            })
+            .collect();
+        for (c, (array, width)) in self.arrays.iter_mut().zip(WIDTHS).enumerate() {
+            let per = n * width;
+            if per == 0 {
+                continue;
+            }
+            let worlds = array.chunks_mut(room * per).skip(first).take(b);
+            for (s, world) in each.iter_mut().zip(worlds) {
+                s.rows[c] = &mut world[frames.start * per..frames.end * per];
+            }
+        }
+        each
     }
 
     /// Keeps the frames of steps 0..=`k` only.
@@ -921,40 +928,19 @@ fn frame_of(k: u64, every: u64, steps: u64) -> Option<usize> {
     }
 }
 
-/// Worlds `worlds`' rows (`per` numbers each) in `frames` of a buffer of (T, W, per),
-/// a list of rows a world.
-fn rows_of<'a>(
-    buffer: &'a mut [f64],
-    per: usize,
-    w: usize,
-    worlds: std::ops::Range<usize>,
-    frames: &std::ops::Range<usize>,
-) -> Vec<Vec<&'a mut [f64]>> {
-    let len = frames.len();
-    let mut rows: Vec<Vec<&mut [f64]>> = worlds.clone().map(|_| Vec::with_capacity(len)).collect();
-    if per == 0 {
-        rows.iter_mut()
-            .for_each(|r| r.resize_with(len, Default::default));
-        return rows;
-    }
-    let chosen = &mut buffer[frames.start * w * per..frames.end * w * per];
-    for frame in chosen.chunks_mut(w * per) {
-        let each = frame[worlds.start * per..worlds.end * per].chunks_mut(per);
-        rows.iter_mut().zip(each).for_each(|(r, row)| r.push(row));
-    }
-    rows
-}
-
-/// One world's rows in the frames from `first` on: a row of N bodies in each array a
-/// frame.
+/// One world's rows from frame `first` on, in each of the four arrays: frame after frame,
+/// N bodies a frame.
 struct Slots<'a> {
     first: usize,
     every: u64,
     steps: u64,
-    position: Vec<&'a mut [f64]>,
-    orientation: Vec<&'a mut [f64]>,
-    velocity: Vec<&'a mut [f64]>,
-    angular_velocity: Vec<&'a mut [f64]>,
+    bodies: usize,
+    rows: [&'a mut [f64]; 4],
+}
+
+/// Row `t` of `per` numbers of `rows`, if it has one.
+fn row(rows: &mut [f64], t: usize, per: usize) -> Option<&mut [f64]> {
+    rows.get_mut(t * per..(t + 1) * per)
 }
 
 impl Slots<'_> {
@@ -964,11 +950,13 @@ impl Slots<'_> {
         else {
             return;
         };
+        let n = self.bodies;
+        let [p, q, v, a] = &mut self.rows;
         let (Some(p), Some(q), Some(v), Some(a)) = (
-            self.position.get_mut(t),
-            self.orientation.get_mut(t),
-            self.velocity.get_mut(t),
-            self.angular_velocity.get_mut(t),
+            row(p, t, n * 3),
+            row(q, t, n * 4),
+            row(v, t, n * 3),
+            row(a, t, n * 3),
         ) else {
             return;
         };
@@ -1051,8 +1039,12 @@ struct Recorded {
 impl Recorded {
     /// (T, W, N): the frames, worlds and bodies recorded.
     fn lead(&self, g: &BatchInner) -> [usize; 3] {
-        let t = crate::sim::frame_count(self.plan.steps, self.every) as usize;
-        [t, g.batch.len(), g.batch.body_ids().len()]
+        [self.lead_frames(), g.batch.len(), g.batch.body_ids().len()]
+    }
+
+    /// T, the frames of the whole run.
+    fn lead_frames(&self) -> usize {
+        crate::sim::frame_count(self.plan.steps, self.every) as usize
     }
 
     /// The time of each of the first `count` frames, from the start of the run.
@@ -1076,15 +1068,19 @@ impl Recorded {
     /// The run recorded into fresh arrays, returned as a new Trajectory.
     fn into_new(self, py: Python<'_>, g: &mut BatchInner) -> PyResult<Py<Trajectory>> {
         let [t, w, n] = self.lead(g);
-        let mut arrays = WIDTHS.map(|width| vec![0.0; t * w * n * width]);
+        let mut arrays = WIDTHS.map(|width| vec![0.0; w * t * n * width]);
         let (outcome, kept) = self.record(py, g, arrays.each_mut().map(|a| a.as_mut_slice()));
-        for (a, width) in arrays.iter_mut().zip(WIDTHS) {
-            a.truncate(kept * w * n * width);
-        }
         let [p, q, v, a] = arrays;
-        let time = self.times(kept).collect();
-        let traj = Trajectory::of_frames(py, [time, p, q, v, a], &[kept, w, n], g.names.clone())?;
-        finished(py, outcome, Py::new(py, traj)?)
+        let seen = |data: Vec<f64>, width: usize| -> PyResult<Py<PyAny>> {
+            let stored = PyArray1::from_vec(py, data).reshape([w, t, n, width])?;
+            Ok(stored
+                .call_method1(intern!(py, "swapaxes"), (0, 1))?
+                .unbind())
+        };
+        let time = PyArray1::from_iter(py, self.times(t)).into_any().unbind();
+        let arrays = [time, seen(p, 3)?, seen(q, 4)?, seen(v, 3)?, seen(a, 3)?];
+        let traj = Trajectory::of_arrays(arrays, g.names.clone());
+        self.finish(py, outcome, kept, traj.into_pyobject(py)?)
     }
 
     /// The run recorded into the arrays of `out`, a Trajectory of the same shapes,
@@ -1117,29 +1113,41 @@ impl Recorded {
         ];
         let (outcome, kept) = self.record(py, g, arrays);
         drop((time, p, q, v, a));
-        if kept == t {
-            return finished(py, outcome, traj.clone().unbind());
-        }
-        let head = |a: &Py<PyAny>| -> PyResult<Py<PyAny>> {
-            Ok(a.bind(py)
-                .get_item(PySlice::new(py, 0, kept as isize, 1))?
-                .unbind())
+        self.finish(py, outcome, kept, traj.clone())
+    }
+
+    /// The run's trajectory `traj`, or the failure it ended in carrying the frames
+    /// recorded whole (the first `kept`, views of `traj`'s arrays).
+    fn finish(
+        &self,
+        py: Python<'_>,
+        outcome: Result<(), Stop>,
+        kept: usize,
+        traj: Bound<'_, Trajectory>,
+    ) -> PyResult<Py<Trajectory>> {
+        let t = self.lead_frames();
+        let traj = if kept < t {
+            let head = |a: &Py<PyAny>| -> PyResult<Py<PyAny>> {
+                let frames = PySlice::new(py, 0, kept as isize, 1);
+                Ok(a.bind(py).get_item(frames)?.unbind())
+            };
+            let [time, p, q, v, a] = traj.get().arrays();
+            let arrays = [head(time)?, head(p)?, head(q)?, head(v)?, head(a)?];
+            Trajectory::of_arrays(arrays, traj.get().names().to_vec()).into_pyobject(py)?
+        } else {
+            traj
         };
-        let arrays = traj.get().arrays();
-        let [time, p, q, v, a] = [
-            head(arrays[0])?,
-            head(arrays[1])?,
-            head(arrays[2])?,
-            head(arrays[3])?,
-            head(arrays[4])?,
-        ];
-        let heads = Trajectory::of_arrays([time, p, q, v, a], g.names.clone());
-        finished(py, outcome, Py::new(py, heads)?)
+        match outcome {
+            Ok(()) => Ok(traj.unbind()),
+            Err(Stop::Failed(f)) => Err(failure(py, &f, Some(traj.into_any().unbind()))),
+            Err(Stop::Python(e)) => Err(e),
+        }
     }
 }
 
-/// `array`, to be written by a run: a writable C-contiguous float64 array of `shape`,
-/// else refused naming `field`.
+/// `array`, to be written by a run: a writable float64 array of `shape` (T, ...) as
+/// `Batch.simulate` makes them, stored with its first two axes swapped (a (T,) array as
+/// it is), else refused naming `field`. Returns the stored array, borrowed for writing.
 fn writable<'py>(
     py: Python<'py>,
     array: &Py<PyAny>,
@@ -1160,8 +1168,8 @@ fn writable<'py>(
         invalid(
             field,
             format!(
-                "must be a writable C-contiguous float64 array of shape {}, the frames this \
-                 run records; got {got}",
+                "must be a writable float64 array of shape {}, laid out as Batch.simulate \
+                 makes it, for the frames this run records; got {got}",
                 text(shape)
             ),
         )
@@ -1172,10 +1180,19 @@ fn writable<'py>(
     if a.shape() != shape {
         return Err(refuse(format!("shape {}", text(a.shape()))));
     }
-    if !a.is_c_contiguous() {
-        return Err(refuse("an array that is not C-contiguous".into()));
+    let stored = if shape.len() > 1 {
+        let swapped = a.call_method1(intern!(py, "swapaxes"), (0, 1))?;
+        swapped
+            .cast_into::<PyArrayDyn<f64>>()
+            .map_err(PyErr::from)?
+    } else {
+        a.clone()
+    };
+    if !stored.is_c_contiguous() {
+        return Err(refuse("an array laid out otherwise".into()));
     }
-    a.try_readwrite()
+    stored
+        .try_readwrite()
         .map_err(|_| refuse("an array that is read-only or borrowed".into()))
 }
 
@@ -1184,19 +1201,6 @@ fn slice<'b>(array: &'b mut PyReadwriteArrayDyn<'_, f64>) -> PyResult<&'b mut [f
     array
         .as_slice_mut()
         .map_err(|_| invalid("out", "its arrays must be C-contiguous"))
-}
-
-/// A run's outcome as Python sees it: `traj`, or the step's failure carrying it.
-fn finished(
-    py: Python<'_>,
-    outcome: Result<(), Stop>,
-    traj: Py<Trajectory>,
-) -> PyResult<Py<Trajectory>> {
-    match outcome {
-        Ok(()) => Ok(traj),
-        Err(Stop::Failed(f)) => Err(failure(py, &f, Some(traj.into_any()))),
-        Err(Stop::Python(e)) => Err(e),
-    }
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

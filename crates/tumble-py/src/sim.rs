@@ -61,28 +61,6 @@ impl Trajectory {
 }
 
 impl Trajectory {
-    /// A batch's recording (`batch.rs`): `data` is time (T,) and position, orientation,
-    /// velocity, angular velocity, each shaped `lead` (T, W, N) and then 3 or 4.
-    pub(crate) fn of_frames(
-        py: Python<'_>,
-        data: [Vec<f64>; 5],
-        lead: &[usize],
-        names: Vec<Option<String>>,
-    ) -> PyResult<Trajectory> {
-        let [time, position, orientation, velocity, angular_velocity] = data;
-        let shape = |width: usize| [lead, &[width]].concat();
-        Ok(Trajectory::of_arrays(
-            [
-                array(py, time, &lead[..1])?,
-                array(py, position, &shape(3))?,
-                array(py, orientation, &shape(4))?,
-                array(py, velocity, &shape(3))?,
-                array(py, angular_velocity, &shape(3))?,
-            ],
-            names,
-        ))
-    }
-
     /// A trajectory of these arrays of time, position, orientation, velocity and angular
     /// velocity, without diagnostics.
     pub(crate) fn of_arrays(arrays: [Py<PyAny>; 5], names: Vec<Option<String>>) -> Trajectory {
@@ -100,6 +78,11 @@ impl Trajectory {
             angular_momentum: None,
             names,
         }
+    }
+
+    /// Its bodies' names.
+    pub(crate) fn names(&self) -> &[Option<String>] {
+        &self.names
     }
 
     /// Its arrays of time, position, orientation, velocity and angular velocity.

@@ -424,6 +424,9 @@ def test_simulate_into_out_overwrites_its_arrays_with_the_same_frames(threads, e
     arrays = [out.time, out.position, out.orientation, out.velocity, out.angular_velocity]
     again = batch().simulate(steps=41, dt=0.01, every=every, out=out)
     assert again is out
+    # Stored world by world (each world's frames one run of memory), seen as (T, W, ...).
+    assert fresh.position.shape == (41 // every + 1 + (41 % every != 0), 19, 2, 3)
+    assert fresh.position.swapaxes(0, 1).flags.c_contiguous
     for name, a in zip(["time", "position", "orientation", "velocity"], arrays):
         assert getattr(again, name) is a
         assert np.array_equal(a, getattr(fresh, name)), name
@@ -435,12 +438,14 @@ def test_simulate_into_out_refuses_arrays_of_another_run():
     out = batch.simulate(steps=10, dt=0.01)
     world = world_of(CART_POLE)
     for kwargs, error, text in [
-        ({"steps": 5}, ValueError, "out.time: must be a writable C-contiguous float64 "
-         "array of shape (6,), the frames this run records; got shape (11,)"),
+        ({"steps": 5}, ValueError, "out.time: must be a writable float64 array of shape "
+         "(6,), laid out as Batch.simulate makes it, for the frames this run records; got "
+         "shape (11,)"),
         ({"steps": 10, "every": 2}, ValueError, "out.time: must be a writable"),
         ({"steps": 10, "out": world.simulate(steps=10, dt=0.01)}, ValueError,
-         "out.position: must be a writable C-contiguous float64 array of shape "
-         "(11, 3, 2, 3), the frames this run records; got shape (11, 2, 3)"),
+         "out.position: must be a writable float64 array of shape (11, 3, 2, 3), laid "
+         "out as Batch.simulate makes it, for the frames this run records; got shape "
+         "(11, 2, 3)"),
         ({"steps": 10, "out": {"time": 1}}, TypeError,
          "out: expected a tumble.Trajectory from Batch.simulate, got dict"),
     ]:
@@ -474,5 +479,9 @@ def test_a_failed_run_into_out_reports_the_frames_before_it():
     a, b = fresh.value.trajectory, into.value.trajectory
     assert 1 <= len(b.time) < 21 and b.position.shape == a.position.shape
     assert np.shares_memory(b.position, out.position)
+    # The failed run's frames are views of part of out: not a layout a run writes into.
+    batch.reset()
+    with pytest.raises(ValueError, match=r"out.position: .* got an array laid out otherwise"):
+        batch.simulate(steps=len(b.time) - 1, dt=0.01, out=b)
     for name in ["time", "position", "orientation", "velocity", "angular_velocity"]:
         assert np.array_equal(getattr(a, name), getattr(b, name)), name
