@@ -1,6 +1,7 @@
 //! `tumble.Batch`: W copies of a world stepped together on the engine's thread pool
 //! (`tumble::Batch`), with every world's state as numpy arrays (W, N, 3) and (W, N, 4),
-//! per-world forces, joint targets and resets, and `simulate` recording (T, W, N, ·).
+//! per-world forces, joint targets and resets, and `simulate` recording (T, W, N, ·)
+//! (stored world by world; see `Frames`), into new arrays or an earlier run's (`out`).
 //!
 //! The binding converts and shapes; the engine checks values (naming the world and the
 //! row: `worlds[2].velocities[1]: ...`) and is all or nothing. Loops run with the
@@ -980,10 +981,13 @@ impl PyBatch {
     /// does, and returns a tumble.Trajectory whose arrays have a world axis: `time` (T,)
     /// (from the start of this run), `position` (T, W, N, 3), `orientation` (T, W, N, 4),
     /// `velocity` and `angular_velocity` (T, W, N, 3); step 0, every `every`-th step and
-    /// the last are recorded. Given `out`, a Trajectory of an earlier Batch.simulate with
-    /// the arrays this run records (same T, W and N), its arrays are overwritten and it
-    /// is returned: a loop of rollouts allocates nothing (as MuJoCo's rollout writes into
-    /// the `state` array it is given); no other thread may touch those arrays meanwhile.
+    /// the last are recorded. The four body arrays are stored world by world (each is a
+    /// (W, T, N, ·) array seen with its first two axes swapped, so `a[:, i]` is one
+    /// contiguous run); np.ascontiguousarray makes a time-major copy. Given `out`, a
+    /// Trajectory of an earlier Batch.simulate with the arrays this run records (same T,
+    /// W and N), its arrays are overwritten and it is returned: a loop of rollouts
+    /// allocates nothing (as MuJoCo's rollout writes into the `state` array it is
+    /// given); no other thread may touch those arrays meanwhile.
     /// The loop runs with the interpreter's lock released. A failed step raises
     /// SimulationError naming the world, whose `trajectory` holds the frames recorded
     /// before it (views of `out`'s arrays when given).

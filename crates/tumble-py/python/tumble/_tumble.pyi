@@ -965,7 +965,8 @@ class Batch:
     ) -> Trajectory:
         """Runs every world as World.simulate does; the Trajectory's arrays have a world
         axis: position (T, W, N, 3), orientation (T, W, N, 4), velocity and
-        angular_velocity (T, W, N, 3), time (T,). Given `out` (a Trajectory of an earlier
+        angular_velocity (T, W, N, 3), time (T,); the body arrays are stored world by
+        world (views with the first two axes swapped). Given `out` (a Trajectory of an earlier
         Batch.simulate with the same T, W and N), its arrays are overwritten in place and
         it is returned, so a loop of rollouts allocates nothing."""
 
