@@ -16,7 +16,7 @@
 //! contacts beside last step's and swaps back; what remains (the sleep state
 //! `wake_touched` changes, the joints' warm starts, reactions and broken flags, the
 //! integrator's memory, the kinematic targets taken) is copied before the stages run,
-//! about 30 bytes per body and 160 per joint. (Whole joints were copied before: a ninth
+//! about 30 bytes per body and 180 per joint. (Whole joints were copied before: a ninth
 //! of a cart-pole's step in reduced coordinates, for fields no stage writes.)
 //! Force callbacks are the user's code and are not undone. A callback that stops the
 //! step (`ForceContext::fail`, how Python's exceptions leave a callback) has the step
