@@ -60,6 +60,11 @@ fn join(
     w.create_joint(&def).unwrap()
 }
 
+/// A free hinge about z (see `join`): the joint of most trees here.
+fn pin(w: &mut World, a: (BodyId, Vec3), b: (Option<BodyId>, Vec3)) -> JointId {
+    join(w, free_hinge(), a, b, Vec3::Z)
+}
+
 /// The largest distance between a joint's two anchors, over all joints (across the
 /// axis, for a slider: along it they may part).
 fn max_joint_gap(w: &World) -> Real {
@@ -101,13 +106,7 @@ fn rod_pendulum(length: Real, angle: Real) -> (World, BodyId) {
         )
         .unwrap();
     let top = Vec3::new(0.0, 0.5 * length, 0.0);
-    join(
-        &mut w,
-        free_hinge(),
-        (rod, top),
-        (None, Vec3::ZERO),
-        Vec3::Z,
-    );
+    pin(&mut w, (rod, top), (None, Vec3::ZERO));
     (w, rod)
 }
 
@@ -246,21 +245,9 @@ fn a_reduced_double_pendulum_keeps_its_energy_and_converges_at_first_order() {
         let first = block(&mut w, Vec3::new(0.5, 0.0, 0.0), half, 1.0);
         let second = block(&mut w, Vec3::new(1.5, 0.0, 0.0), half, 2.0);
         let left = Vec3::new(-0.5, 0.0, 0.0);
-        join(
-            &mut w,
-            free_hinge(),
-            (first, left),
-            (None, Vec3::ZERO),
-            Vec3::Z,
-        );
+        pin(&mut w, (first, left), (None, Vec3::ZERO));
         let right = Vec3::new(0.5, 0.0, 0.0);
-        join(
-            &mut w,
-            free_hinge(),
-            (second, left),
-            (Some(first), right),
-            Vec3::Z,
-        );
+        pin(&mut w, (second, left), (Some(first), right));
         (w, second)
     };
     let (mut w, _) = build();
@@ -365,7 +352,7 @@ fn every_kind(flip: bool) -> (World, Vec<BodyId>) {
         )
         .unwrap();
     let (left, right) = (Vec3::new(-0.5, 0.0, 0.0), Vec3::new(0.5, 0.0, 0.0));
-    join(&mut w, free_hinge(), (a, left), (None, Vec3::ZERO), Vec3::Z);
+    pin(&mut w, (a, left), (None, Vec3::ZERO));
     let pairs = [
         (free_hinge(), (b, left), (a, right), Vec3::Z),
         (
@@ -582,7 +569,7 @@ fn what_is_not_a_free_tree_is_solved_by_the_soft_step_bit_for_bit() {
                 let bar = block(&mut w, Vec3::ZERO, Vec3::new(0.5, 0.05, 0.05), 1.0);
                 for x in [-0.5 as Real, 0.5] {
                     let at = Vec3::new(x, 0.0, 0.0);
-                    join(&mut w, free_hinge(), (bar, at), (None, at), Vec3::Z);
+                    pin(&mut w, (bar, at), (None, at));
                 }
                 w.set_angular_velocity(bar, Vec3::new(0.0, 0.0, 1.0))
                     .unwrap();
@@ -606,13 +593,7 @@ fn what_is_not_a_free_tree_is_solved_by_the_soft_step_bit_for_bit() {
                     1.0,
                 );
                 let left = Vec3::new(-0.5, 0.0, 0.0);
-                join(
-                    &mut w,
-                    free_hinge(),
-                    (rod, left),
-                    (Some(hub), Vec3::ZERO),
-                    Vec3::Z,
-                );
+                pin(&mut w, (rod, left), (Some(hub), Vec3::ZERO));
                 w
             }),
         ),
@@ -629,7 +610,7 @@ fn what_is_not_a_free_tree_is_solved_by_the_soft_step_bit_for_bit() {
                 );
                 let left = Vec3::new(-0.5, 0.0, 0.0);
                 let at = Vec3::new(0.0, 0.05, 0.0);
-                join(&mut w, free_hinge(), (rod, left), (None, at), Vec3::Z);
+                pin(&mut w, (rod, left), (None, at));
                 w
             }),
         ),
@@ -663,13 +644,7 @@ fn a_pendulum_hitting_the_floor_is_handed_to_the_soft_step_and_back() {
         1.0,
     );
     let left = Vec3::new(-0.5, 0.0, 0.0);
-    join(
-        &mut w,
-        free_hinge(),
-        (rod, left),
-        (None, Vec3::new(0.0, 0.8, 0.0)),
-        Vec3::Z,
-    );
+    pin(&mut w, (rod, left), (None, Vec3::new(0.0, 0.8, 0.0)));
     reduced(&mut w, 4);
     let e = |w: &World| {
         let b = w.body(rod).unwrap();
@@ -757,7 +732,7 @@ fn snapshots_setters_and_static_grounds_work_with_reduced_trees() {
                 (Some(beam), Vec3::ZERO, turn.inverse() * Vec3::Z);
             w.create_joint(&d).unwrap();
         } else {
-            join(&mut w, free_hinge(), (rod, left), (None, pivot), Vec3::Z);
+            pin(&mut w, (rod, left), (None, pivot));
         }
         reduced(&mut w, 1);
         run(&mut w, 1.0 / 60.0, 60);
@@ -808,13 +783,7 @@ fn forces_torques_damping_and_break_forces_act_on_reduced_trees() {
         ..Default::default()
     };
     let wheel = w.create_body(&def, Shape::sphere(0.5)).unwrap();
-    join(
-        &mut w,
-        free_hinge(),
-        (wheel, Vec3::ZERO),
-        (None, Vec3::ZERO),
-        Vec3::Z,
-    );
+    pin(&mut w, (wheel, Vec3::ZERO), (None, Vec3::ZERO));
     let spin = AppliedForce {
         body: wheel,
         force: Vec3::ZERO,
@@ -917,21 +886,9 @@ fn a_tree_in_contact_beside_a_free_one_is_the_soft_steps_alone() {
         let half = Vec3::new(0.5, 0.05, 0.05);
         let lying = block(&mut w, Vec3::new(0.5, 0.05, 0.0), half, 1.0);
         let left = Vec3::new(-0.5, 0.0, 0.0);
-        join(
-            &mut w,
-            free_hinge(),
-            (lying, left),
-            (None, Vec3::new(0.0, 0.05, 0.0)),
-            Vec3::Z,
-        );
+        pin(&mut w, (lying, left), (None, Vec3::new(0.0, 0.05, 0.0)));
         let swinging = block(&mut w, Vec3::new(0.5, 3.0, 2.0), half, 1.0);
-        join(
-            &mut w,
-            free_hinge(),
-            (swinging, left),
-            (None, Vec3::new(0.0, 3.0, 2.0)),
-            Vec3::Z,
-        );
+        pin(&mut w, (swinging, left), (None, Vec3::new(0.0, 3.0, 2.0)));
         (w, lying)
     };
     let run = |trees: JointTrees| {
