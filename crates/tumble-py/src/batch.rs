@@ -11,8 +11,8 @@ use std::sync::{Mutex, MutexGuard, TryLockError};
 use std::time::{Duration, Instant};
 
 use numpy::{
-    AllowTypeChange, PyArray1, PyArrayDyn, PyArrayLike1, PyArrayLike3, PyArrayMethods,
-    PyReadwriteArrayDyn, PyUntypedArrayMethods,
+    AllowTypeChange, PyArrayDyn, PyArrayLike1, PyArrayLike3, PyArrayMethods, PyReadwriteArrayDyn,
+    PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{PyKeyError, PyRuntimeError};
 use pyo3::intern;
@@ -1076,12 +1076,13 @@ impl Recorded {
         let (outcome, kept) = self.record(py, g, arrays.each_mut().map(|a| a.as_mut_slice()));
         let [p, q, v, a] = arrays;
         let seen = |data: Vec<f64>, width: usize| -> PyResult<Py<PyAny>> {
-            let stored = PyArray1::from_vec(py, data).reshape([w, t, n, width])?;
-            Ok(stored
-                .call_method1(intern!(py, "swapaxes"), (0, 1))?
-                .unbind())
+            let stored = array(py, data, &[w, t, n, width])?;
+            let swapped = stored
+                .bind(py)
+                .call_method1(intern!(py, "swapaxes"), (0, 1))?;
+            Ok(swapped.unbind())
         };
-        let time = PyArray1::from_iter(py, self.times(t)).into_any().unbind();
+        let time = array(py, self.times(t).collect(), &[t])?;
         let arrays = [time, seen(p, 3)?, seen(q, 4)?, seen(v, 3)?, seen(a, 3)?];
         let traj = Trajectory::of_arrays(arrays, g.names.clone());
         self.finish(py, outcome, kept, traj.into_pyobject(py)?)
